@@ -1,0 +1,35 @@
+# Two commands for a new machine:  `make demo`  and  `make test`.
+PYTHON ?= python3.13
+VENV   := .venv
+PY     := $(VENV)/bin/python
+STAMP  := $(VENV)/.installed
+
+.PHONY: venv demo test test-all benchmark clean
+
+# The venv is rebuilt when setup.cfg changes.
+$(STAMP): setup.cfg pyproject.toml
+	@command -v $(PYTHON) >/dev/null 2>&1 || { echo "error: $(PYTHON) not found; install Python 3.13 (pyenv install 3.13) or run make PYTHON=/path/to/python3.13"; exit 1; }
+	test -x $(PY) || $(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -e '.[test]'
+	touch $(STAMP)
+
+venv: $(STAMP)
+
+# Train the default experiment (LunarLander DQN, default preset) until solved, then
+# write its plot and an MP4 of the trained agent.
+demo: $(STAMP)
+	$(PY) main.py train lunar_lander dqn --wandb offline --video
+
+test: $(STAMP)
+	$(PY) -m pytest -q
+
+# Also the slow learning runs marked `expensive`.
+test-all: $(STAMP)
+	$(PY) -m pytest -q -m ""
+
+benchmark: $(STAMP)
+	$(PY) benchmarks/lunar_lander.py dqn
+
+clean:
+	rm -rf runs wandb videos .pytest_cache

@@ -1,0 +1,260 @@
+#!/usr/bin/env python3
+"""Train, evaluate and render the package's deep-RL systems.
+
+  python main.py list
+  python main.py train lunar_lander dqn [--preset article|default] [--seed 0] [--lr 5e-4 ...]
+  python main.py evaluate lunar_lander dqn [--model saved_networks/lunar_lander/dqn] [--episodes 100]
+  python main.py render lunar_lander dqn [--out lander.mp4]
+
+TensorFlow is imported only inside the commands that need it, so `list` and `--help` are quick.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shutil
+import sys
+from pathlib import Path
+
+os.environ.setdefault("TF_CPP_MIN_LOG_LEVEL", "2")
+
+from rlcore.errors import UserError  # noqa: E402  (TF-free)
+
+SAVED_NETWORKS = Path("saved_networks")
+
+
+def shipped_dir(experiment: str, algo: str) -> Path:
+    return SAVED_NETWORKS / experiment / algo
+
+
+# ---------------------------------------------------------------- commands
+def cmd_list(args) -> int:
+    from rlcore.experiment import experiment_names, get_experiment
+    from rlcore.policies import read_meta
+
+    for name in experiment_names():
+        exp = get_experiment(name)
+        print(f"{name}: {exp.description}")
+        for algo, spec in exp.algos.items():
+            folder = shipped_dir(name, algo)
+            shipped = "no shipped model"
+            if (folder / "meta.json").is_file():
+                ev = read_meta(folder).get("evaluation")
+                shipped = (f"shipped: {ev['mean']:.1f} +- {ev['std']:.1f} over {ev['episodes']} episodes"
+                           if ev else "shipped (not evaluated)")
+            print(f"  {algo:<14} {spec.description:<24} presets: {', '.join(spec.presets):<18} {shipped}")
+    return 0
+
+
+def _spec_from_args(args):
+    from rlcore.experiment import get_experiment
+    from rlcore.hparams import apply_overrides, overrides_from_args
+    from rlcore.trainers.session import RunSpec, check_resumable, latest_run_dir, new_run_dir
+
+    exp = get_experiment(args.experiment)
+    overrides = overrides_from_args(args)
+    if args.episodes is not None:
+        overrides["max_episodes"] = args.episodes
+    if args.steps is not None:
+        overrides["max_env_steps"] = args.steps
+    if args.resume is not None:
+        run_dir = latest_run_dir(exp.name, args.algo) if args.resume == "latest" else Path(args.resume)
+        spec = RunSpec(exp, args.algo, args.preset or "", None, args.seed, args.wandb, run_dir, True,
+                       progress=not args.no_progress)
+        state = check_resumable(spec)
+        from rlcore.configs import A2CConfig, DQNConfig
+        from rlcore.hparams import from_dict
+        cls = {"dqn": DQNConfig, "a2c": A2CConfig}[spec.kind]
+        # the checkpoint's own hyperparameters; budgets may be raised from the command line
+        spec.config = apply_overrides(from_dict(cls, state["config"]), overrides)
+        spec.preset, spec.seed = state["preset"], state["seed"]
+        print(f"resuming {run_dir} at episode {len(state['returns'])}, env step {state['env_steps']}")
+        return spec
+    config = apply_overrides(exp.preset(args.algo, args.preset), overrides)
+    preset = args.preset or exp.algo(args.algo).default_preset
+    return RunSpec(exp, args.algo, preset, config, args.seed, args.wandb,
+                   Path(args.run_dir) if args.run_dir else new_run_dir(exp.name, args.algo, args.seed),
+                   progress=not args.no_progress)
+
+
+def cmd_train(args) -> int:
+    import importlib
+
+    spec = _spec_from_args(args)
+    trainer = importlib.import_module(f"rlcore.trainers.{spec.kind}")
+    print(f"training {spec.experiment.name} {spec.algo} ({spec.preset} preset, seed {spec.seed}) "
+          f"-> {spec.run_dir}")
+    model_dir = trainer.train(spec)
+    meta = json.loads((model_dir / "meta.json").read_text())
+    print(f"trained: {meta['episodes']} episodes, {meta['env_steps']} env steps, "
+          f"{meta['wall_seconds']:.0f} s; last-100 average {meta['final_average']:.1f}")
+    if args.eval_episodes > 0:
+        meta = _evaluate_into_meta(model_dir, args.eval_episodes)
+    print(f"model:   {model_dir}/")
+    print(f"plot:    {model_dir / meta['plot']}")
+    print(f"metrics: {model_dir / 'metrics.csv'}")
+    if args.video:
+        _render(model_dir, model_dir / f"{spec.experiment.name}_{spec.algo}.mp4", None, 1, None)
+    if args.publish:
+        target = shipped_dir(spec.experiment.name, spec.algo)
+        _publish(model_dir, target)
+        print(f"published to {target}/")
+    return 0
+
+
+def _evaluate_into_meta(model_dir: Path, episodes: int) -> dict:
+    from rlcore.atomic import write_json
+    from rlcore.evaluation import evaluate
+    from rlcore.policies import load_policy
+
+    exp, meta, policy = load_policy(model_dir)
+    returns = evaluate(exp, policy, episodes)
+    meta["evaluation"] = {"episodes": episodes, "mean": round(float(returns.mean()), 2),
+                          "std": round(float(returns.std()), 2), "min": round(float(returns.min()), 2),
+                          "seeds": f"{exp.eval_seed_base}..{exp.eval_seed_base + episodes - 1}",
+                          "policy": "greedy"}
+    write_json(model_dir / "meta.json", meta)
+    print(f"greedy evaluation over {episodes} unseen-seed episodes: "
+          f"{returns.mean():.1f} +- {returns.std():.1f} (min {returns.min():.1f})")
+    return meta
+
+
+def _publish(model_dir: Path, target: Path) -> None:
+    """Copy a finished model folder into saved_networks/, each file atomically, meta.json last."""
+    from rlcore.atomic import write_atomic
+
+    target.mkdir(parents=True, exist_ok=True)
+    files = sorted(p for p in model_dir.iterdir() if p.is_file() and p.name != "meta.json")
+    for src in files + [model_dir / "meta.json"]:
+        write_atomic(target / src.name, lambda tmp, src=src: shutil.copyfile(src, tmp))
+
+
+def _model_dir(args) -> Path:
+    from rlcore.experiment import get_experiment
+
+    get_experiment(args.experiment).algo(args.algo)  # unknown names -> clear error
+    return Path(args.model) if args.model else shipped_dir(args.experiment, args.algo)
+
+
+def cmd_evaluate(args) -> int:
+    from rlcore.evaluation import evaluate
+    from rlcore.policies import load_policy
+
+    model_dir = _model_dir(args)
+    exp, meta, policy = load_policy(model_dir, args.experiment, args.algo)
+    returns = evaluate(exp, policy, args.episodes, args.seed_base)
+    solved = (returns.mean() >= exp.solved_score)
+    print(f"{exp.name} {args.algo} ({model_dir}): greedy return {returns.mean():.1f} +- {returns.std():.1f} "
+          f"over {len(returns)} episodes (min {returns.min():.1f}, max {returns.max():.1f}); "
+          f"solved threshold {exp.solved_score:g}: {'met' if solved else 'not met'}")
+    return 0
+
+
+def _render(model_dir: Path, out: Path, fps: int | None, episodes: int, seed: int | None) -> None:
+    from rlcore.policies import load_policy
+    from rlcore.video import record_video
+
+    exp, meta, policy = load_policy(model_dir)
+    result = record_video(exp, policy, out, fps or exp.video_fps, episodes, seed)
+    print(f"video:   {out} ({result['frames']} frames at {result['fps']} fps; "
+          f"episode returns {', '.join(f'{r:.1f}' for r in result['returns'])})")
+
+
+def cmd_render(args) -> int:
+    model_dir = _model_dir(args)
+    from rlcore.policies import load_policy
+    load_policy(model_dir, args.experiment, args.algo)  # checks before any file is written
+    out = Path(args.out) if args.out else Path("videos") / f"{args.experiment}_{args.algo}.mp4"
+    _render(model_dir, out, args.fps, args.episodes, args.seed)
+    return 0
+
+
+# ------------------------------------------------------------------ parser
+def build_parser(argv: list[str]) -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="main.py", description="TensorFlow 2 / Keras deep RL: train, evaluate and render agents.",
+        epilog="`main.py list` shows experiments, algorithms, presets and shipped models.")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    sub.add_parser("list", help="experiments, algorithms, presets and shipped models with their scores")
+
+    train = sub.add_parser("train", help="train an agent (Ctrl-C saves a checkpoint; --resume continues)",
+                           description="Train an agent. Every hyperparameter of the chosen preset can be "
+                                       "overridden; `main.py train EXPERIMENT ALGO --help` lists them.")
+    train.add_argument("experiment", help="e.g. lunar_lander")
+    train.add_argument("algo", help="e.g. dqn, ddqn, dueling_dqn, dueling_ddqn, a2c")
+    train.add_argument("--preset", default=None, help="article | default (default: default)")
+    train.add_argument("--episodes", type=int, default=None, help="episode budget (max_episodes)")
+    train.add_argument("--steps", type=int, default=None, help="env step budget (max_env_steps)")
+    train.add_argument("--seed", type=int, default=0, help="seeds numpy, TensorFlow and the env (default 0)")
+    train.add_argument("--wandb", default="auto", choices=["auto", "online", "offline", "off"],
+                       help="auto = online when logged in, else offline (default auto)")
+    train.add_argument("--resume", nargs="?", const="latest", default=None, metavar="RUN_DIR",
+                       help="continue a run from its checkpoint (default: the latest run of this algo)")
+    train.add_argument("--run-dir", default=None, help="where the run writes (default runs/<name>)")
+    train.add_argument("--eval-episodes", type=int, default=100,
+                       help="greedy evaluation episodes after training, on unseen seeds (default 100)")
+    train.add_argument("--video", action="store_true", help="also render an MP4 of the trained agent")
+    train.add_argument("--publish", action="store_true",
+                       help="copy the trained model into saved_networks/EXPERIMENT/ALGO/")
+    train.add_argument("--no-progress", action="store_true", help="no progress bar")
+    _add_hyperparameters(train, argv)
+
+    for name, text in (("evaluate", "greedy mean +- std of a saved model"),
+                       ("render", "MP4 of a saved model playing greedily")):
+        p = sub.add_parser(name, help=text, description=text)
+        p.add_argument("experiment")
+        p.add_argument("algo")
+        p.add_argument("--model", default=None,
+                       help="model folder (default saved_networks/EXPERIMENT/ALGO)")
+        if name == "evaluate":
+            p.add_argument("--episodes", type=int, default=100)
+            p.add_argument("--seed-base", type=int, default=None,
+                           help="episode i uses seed SEED_BASE+i (default: the experiment's unseen range)")
+        else:
+            p.add_argument("--out", default=None, help="MP4 path (default videos/EXPERIMENT_ALGO.mp4)")
+            p.add_argument("--fps", type=int, default=None, help="frames per second (default: experiment's)")
+            p.add_argument("--episodes", type=int, default=1)
+            p.add_argument("--seed", type=int, default=None)
+    return parser
+
+
+def _add_hyperparameters(train: argparse.ArgumentParser, argv: list[str]) -> None:
+    """Once EXPERIMENT and ALGO are on the command line, add one flag per hyperparameter."""
+    if argv[:1] != ["train"]:
+        return
+    names = [a for a in argv[1:3] if not a.startswith("-")]
+    if len(names) < 2:
+        return
+    from rlcore.experiment import get_experiment
+    from rlcore.hparams import add_arguments
+
+    preset = argv[argv.index("--preset") + 1] if "--preset" in argv[:-1] else None
+    add_arguments(train, get_experiment(names[0]).preset(names[1], preset))
+
+
+COMMANDS = {"list": cmd_list, "train": cmd_train, "evaluate": cmd_evaluate, "render": cmd_render}
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    try:
+        args = build_parser(argv).parse_args(argv)
+        return COMMANDS[args.command](args)
+    except UserError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("\naborted (no checkpoint written by this interrupt)", file=sys.stderr)
+        return 130
+    except Exception as exc:
+        from rlcore.trainers.session import Interrupted
+        if isinstance(exc, Interrupted):
+            print(str(exc), file=sys.stderr)
+            return 130
+        raise
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,1 @@
+"""Agents: one file per algorithm, Keras models and a compiled GradientTape train step."""

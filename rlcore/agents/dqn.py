@@ -1,0 +1,167 @@
+"""Deep Q-learning: DQN, Double DQN, Dueling DQN and Dueling Double DQN in one agent.
+
+- Dueling lives in the network (:func:`build_q_network`), Double in the target
+  (:meth:`DQNAgent.td_target`): the four LunarLander variants are two switches.
+- The whole update (target, loss, gradient step, soft target update) is one ``tf.function``.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import keras
+import numpy as np
+import tensorflow as tf
+from keras import layers
+
+from rlcore.configs import DQNConfig
+from rlcore.layers import DuelingCombine
+from rlcore.models import load_keras_model, save_keras_model
+
+
+def build_q_network(obs_dim: int, n_actions: int, hidden=(64, 64), dueling: bool = False,
+                    name: str = "q_network") -> keras.Model:
+    """A Functional MLP from observations to one Q-value per action."""
+    obs = keras.Input((obs_dim,), name="obs")
+    x = obs
+    for i, units in enumerate(hidden):
+        x = layers.Dense(units, activation="relu", name=f"hidden_{i}")(x)
+    if dueling:
+        value = layers.Dense(1, name="value")(x)
+        advantage = layers.Dense(n_actions, name="advantage")(x)
+        q_values = DuelingCombine(name="q_values")([value, advantage])
+    else:
+        q_values = layers.Dense(n_actions, name="q_values")(x)
+    return keras.Model(obs, q_values, name=name)
+
+
+def numpy_q_values(weights: list[np.ndarray], obs: np.ndarray, dueling: bool) -> np.ndarray:
+    """The Q-network's forward pass in numpy, from ``model.get_weights()`` order.
+
+    Used for fast acting and as the reference the Keras model is tested against.
+    """
+    n_head = 4 if dueling else 2
+    x = obs
+    for kernel, bias in zip(weights[:-n_head:2], weights[1:-n_head:2]):
+        x = np.maximum(x @ kernel + bias, 0.0)
+    if not dueling:
+        return x @ weights[-2] + weights[-1]
+    value = x @ weights[-4] + weights[-3]
+    advantage = x @ weights[-2] + weights[-1]
+    return value + advantage - advantage.mean(axis=-1, keepdims=True)
+
+
+def make_optimizer(cfg: DQNConfig) -> keras.optimizers.Optimizer:
+    if cfg.optimizer == "adam":
+        return keras.optimizers.Adam(cfg.lr)
+    if cfg.optimizer == "adamw":  # the PyTorch tutorial's AdamW(amsgrad=True), weight decay 0.01
+        return keras.optimizers.AdamW(cfg.lr, weight_decay=0.01, amsgrad=True)
+    raise ValueError(f"unknown optimizer {cfg.optimizer!r} (adam | adamw)")
+
+
+class DQNAgent:
+    """Epsilon-greedy Q-learning agent with a target network that tracks the online one softly."""
+
+    def __init__(self, obs_dim: int, n_actions: int, cfg: DQNConfig):
+        if cfg.loss not in ("mse", "huber"):
+            raise ValueError(f"unknown loss {cfg.loss!r} (mse | huber)")
+        self.obs_dim, self.n_actions, self.cfg = obs_dim, n_actions, cfg
+        self.q_network = build_q_network(obs_dim, n_actions, cfg.hidden, cfg.dueling)
+        self.target_network = build_q_network(obs_dim, n_actions, cfg.hidden, cfg.dueling,
+                                              name="target_q_network")
+        self.target_network.set_weights(self.q_network.get_weights())
+        self.optimizer = make_optimizer(cfg)
+        self.optimizer.build(self.q_network.trainable_variables)
+        self.sync_policy_weights()
+        obs_spec = tf.TensorSpec([None, obs_dim], tf.float32)
+        self._train = tf.function(self._train_graph, input_signature=[
+            obs_spec, tf.TensorSpec([None], tf.int32), tf.TensorSpec([None], tf.float32),
+            obs_spec, tf.TensorSpec([None], tf.float32)])
+
+    # ----------------------------------------------------------------- acting
+    def greedy_actions(self, obs: np.ndarray) -> np.ndarray:
+        """argmax_a Q(s, a) for a batch of observations (numpy forward pass, see below)."""
+        q_values = numpy_q_values(self.policy_weights, np.asarray(obs, np.float32), self.cfg.dueling)
+        return q_values.argmax(axis=1)
+
+    def act(self, obs: np.ndarray, epsilon: float, rng: np.random.Generator) -> int:
+        """Epsilon-greedy action for one observation.
+
+        Acting runs the online network in numpy on a copy of its weights that every train step
+        returns: on this 2-core CPU a compiled TF call costs ~0.8 ms, the numpy pass ~0.03 ms.
+        """
+        if rng.random() < epsilon:
+            return int(rng.integers(self.n_actions))
+        return int(self.greedy_actions(obs[None])[0])
+
+    def sync_policy_weights(self) -> None:
+        """Refresh the numpy copy of the online weights (after loading or restoring)."""
+        self.policy_weights = [np.array(w) for w in self.q_network.get_weights()]
+
+    # --------------------------------------------------------------- learning
+    def td_target(self, reward, next_obs, terminated):
+        """r + gamma * Q_target(s', a*) unless terminated (truncated episodes still bootstrap).
+
+        a* = argmax of the target net (DQN) or of the online net (Double DQN).
+        """
+        next_q_target = self.target_network(next_obs)
+        chooser = self.q_network(next_obs) if self.cfg.double else next_q_target
+        next_action = tf.argmax(chooser, axis=1, output_type=tf.int32)
+        next_value = tf.gather(next_q_target, next_action, batch_dims=1)
+        return reward + self.cfg.gamma * (1.0 - terminated) * next_value
+
+    def _train_graph(self, obs, action, reward, next_obs, terminated):
+        td_target = tf.stop_gradient(self.td_target(reward, next_obs, terminated))
+        with tf.GradientTape() as tape:
+            q_values = self.q_network(obs, training=True)
+            q_taken = tf.gather(q_values, action, batch_dims=1)
+            error = td_target - q_taken
+            if self.cfg.loss == "huber":  # delta = 1, PyTorch's SmoothL1Loss
+                abs_error = tf.abs(error)
+                per_sample = tf.where(abs_error < 1.0, 0.5 * tf.square(error), abs_error - 0.5)
+            else:
+                per_sample = tf.square(error)
+            loss = tf.debugging.check_numerics(tf.reduce_mean(per_sample), "DQN loss")
+        grads = tape.gradient(loss, self.q_network.trainable_variables)
+        if self.cfg.grad_clip_value > 0:
+            grads = [tf.clip_by_value(g, -self.cfg.grad_clip_value, self.cfg.grad_clip_value)
+                     for g in grads]
+        self.optimizer.apply_gradients(zip(grads, self.q_network.trainable_variables))
+        self.soft_update()
+        return {"loss": loss, "q_mean": tf.reduce_mean(q_taken)}, self.q_network.weights
+
+    def soft_update(self):
+        """target <- tau * online + (1 - tau) * target."""
+        tau = self.cfg.tau
+        for target_var, online_var in zip(self.target_network.weights, self.q_network.weights):
+            target_var.assign(tau * online_var + (1.0 - tau) * target_var)
+
+    def train_step(self, obs, action, reward, next_obs, terminated) -> dict[str, float]:
+        """One gradient step on a minibatch; returns the named losses as floats."""
+        losses, weights = self._train(obs, action, reward, next_obs, terminated)
+        self.policy_weights = [w.numpy() for w in weights]
+        return {k: float(v) for k, v in losses.items()}
+
+    # ------------------------------------------------------------ persistence
+    MODEL_FILE = "q_network.h5"
+
+    def save(self, folder: str | Path) -> Path:
+        return save_keras_model(self.q_network, Path(folder) / self.MODEL_FILE)
+
+    def models(self) -> dict[str, keras.Model]:
+        return {"q_network": self.q_network, "target_network": self.target_network}
+
+    def optimizers(self) -> dict[str, keras.optimizers.Optimizer]:
+        return {"optimizer": self.optimizer}
+
+
+class GreedyQPolicy:
+    """A saved Q-network (``q_network.h5``) as a greedy policy, for evaluate and render."""
+
+    def __init__(self, folder: str | Path, obs_dim: int, n_actions: int):
+        self.model = load_keras_model(Path(folder) / DQNAgent.MODEL_FILE, obs_dim, n_actions)
+        self._greedy = tf.function(lambda obs: tf.argmax(self.model(obs), axis=1, output_type=tf.int32),
+                                   input_signature=[tf.TensorSpec([None, obs_dim], tf.float32)])
+
+    def __call__(self, obs: np.ndarray) -> np.ndarray:
+        """Greedy actions for a batch of observations."""
+        return self._greedy(np.asarray(obs, np.float32)).numpy()

@@ -1,0 +1,72 @@
+"""Checkpoints for resuming: weights, optimizer state, counters, RNG state and replay, in one ``.npz``.
+
+One file written atomically: a crash or Ctrl-C during the save leaves the previous checkpoint intact.
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from rlcore.atomic import atomic_path
+from rlcore.errors import UserError
+
+
+def save_checkpoint(path: str | Path, models: dict, optimizers: dict, state: dict,
+                    arrays: dict[str, np.ndarray] | None = None) -> Path:
+    """Write Keras ``models`` and ``optimizers`` (by name), a JSON-able ``state`` and extra ``arrays``."""
+    payload = {"state_json": np.array(json.dumps(state, default=str))}
+    for name, model in models.items():
+        for i, w in enumerate(model.get_weights()):
+            payload[f"model/{name}/{i}"] = w
+    for name, opt in optimizers.items():
+        for i, v in enumerate(opt.variables):
+            payload[f"optimizer/{name}/{i}"] = np.asarray(v)
+    for key, value in (arrays or {}).items():
+        payload[f"array/{key}"] = value
+    path = Path(path)
+    with atomic_path(path) as tmp:
+        with open(tmp, "wb") as f:
+            np.savez(f, **payload)
+    return path
+
+
+def read_checkpoint_state(path: str | Path) -> dict:
+    """Only the JSON state (to check which run a checkpoint belongs to before building anything)."""
+    path = Path(path)
+    if not path.is_file():
+        raise UserError(f"no checkpoint at {path}; nothing to resume")
+    try:
+        with np.load(path) as data:
+            return json.loads(str(data["state_json"]))
+    except Exception as exc:
+        raise UserError(f"checkpoint {path} is damaged or not one of ours ({type(exc).__name__})")
+
+
+def load_checkpoint(path: str | Path, models: dict, optimizers: dict) -> tuple[dict, dict[str, np.ndarray]]:
+    """Restore ``models`` and ``optimizers`` in place; return the state and the extra arrays."""
+    path = Path(path)
+    state = read_checkpoint_state(path)
+    with np.load(path) as data:
+        files = set(data.files)
+        for name, model in models.items():
+            weights = [data[f"model/{name}/{i}"] for i in range(len(model.get_weights()))
+                       if f"model/{name}/{i}" in files]
+            _check_shapes(path, name, [w.shape for w in model.get_weights()], [w.shape for w in weights])
+            model.set_weights(weights)
+        for name, opt in optimizers.items():
+            values = [data[f"optimizer/{name}/{i}"] for i in range(len(opt.variables))
+                      if f"optimizer/{name}/{i}" in files]
+            _check_shapes(path, name, [tuple(v.shape) for v in opt.variables], [v.shape for v in values])
+            for var, value in zip(opt.variables, values):
+                var.assign(value)
+        arrays = {key[len("array/"):]: data[key] for key in files if key.startswith("array/")}
+    return state, arrays
+
+
+def _check_shapes(path, name, expected, found):
+    if [tuple(s) for s in expected] != [tuple(s) for s in found]:
+        raise UserError(f"checkpoint {path} does not match this configuration ({name}: "
+                        f"{len(found)} arrays, expected {len(expected)} of other shapes); "
+                        "it was written by another algorithm or hyperparameters")

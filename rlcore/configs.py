@@ -1,0 +1,65 @@
+"""Hyperparameter dataclasses of the agents. TensorFlow-free, so presets can import them cheaply.
+
+Defaults are the article's values; experiment packages define named presets as instances.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+
+def _h(default, text):
+    return field(default=default, metadata={"help": text})
+
+
+@dataclass(frozen=True)
+class DQNConfig:
+    """Q-learning with replay and a soft-updated target network (DQN, Double, Dueling)."""
+    hidden: tuple[int, ...] = _h((64, 64), "hidden layer sizes of the Q-network (comma separated)")
+    dueling: bool = _h(False, "dueling head: Q = V(s) + A(s,a) - mean_a A(s,a)")
+    double: bool = _h(False, "double DQN target: the online net picks argmax, the target net values it")
+    lr: float = _h(1e-3, "learning rate")
+    optimizer: str = _h("adam", "adam | adamw (adamw uses amsgrad, as the PyTorch tutorial)")
+    loss: str = _h("mse", "mse | huber")
+    grad_clip_value: float = _h(0.0, "clip each gradient element to +-this value (0 = off)")
+    gamma: float = _h(0.995, "discount factor")
+    buffer_size: int = _h(100_000, "replay memory capacity (transitions)")
+    batch_size: int = _h(64, "minibatch size")
+    learn_every: int = _h(4, "one gradient step every this many env steps")
+    learning_starts: int = _h(64, "env steps collected before the first gradient step")
+    tau: float = _h(1e-3, "soft target update rate, applied after every gradient step")
+    eps_start: float = _h(1.0, "initial exploration rate")
+    eps_end: float = _h(0.01, "final exploration rate")
+    eps_decay: float = _h(0.995, "epsilon multiplied by this after every episode")
+    max_episodes: int = _h(2000, "stop after this many episodes")
+    max_env_steps: int = _h(0, "stop after this many env steps (0 = no limit)")
+    max_episode_steps: int = _h(1000, "cap on steps per episode (episodes longer are truncated)")
+    stop_score: float = _h(200.0, "stop once the mean return of the last `window` episodes reaches this")
+    window: int = _h(100, "episodes in the moving average")
+    checkpoint_every: int = _h(50, "episodes between checkpoints")
+
+
+@dataclass(frozen=True)
+class A2CConfig:
+    """Advantage actor-critic: separate Actor and Critic networks, each with its own Adam.
+
+    ``gae_lambda = 0`` is the article's one-step TD target r + gamma V(s'); ``gae_lambda = 1``
+    is the n-step return bootstrapped from the end of the rollout.
+    """
+    actor_hidden: tuple[int, ...] = _h((256, 256), "actor hidden layer sizes")
+    critic_hidden: tuple[int, ...] = _h((256, 256), "critic hidden layer sizes")
+    actor_lr: float = _h(3e-4, "actor learning rate")
+    critic_lr: float = _h(5e-4, "critic learning rate")
+    gamma: float = _h(0.995, "discount factor")
+    num_envs: int = _h(1, "environments stepped together (in-process vector env)")
+    n_steps: int = _h(4, "env steps per env between updates")
+    gae_lambda: float = _h(0.0, "0 = one-step TD target (article), 1 = n-step return, between = GAE")
+    reward_scale: float = _h(0.01, "rewards are multiplied by this in the TD target")
+    entropy_coef: float = _h(0.0, "entropy bonus weight in the actor loss")
+    max_grad_norm: float = _h(0.0, "clip gradients by global norm (0 = off)")
+    normalize_advantage: bool = _h(False, "standardize advantages within each update")
+    max_episodes: int = _h(5000, "stop after this many finished episodes")
+    max_env_steps: int = _h(0, "stop after this many env steps over all envs (0 = no limit)")
+    max_episode_steps: int = _h(1000, "cap on steps per episode (episodes longer are truncated)")
+    stop_score: float = _h(200.0, "stop once the mean return of the last `window` episodes reaches this")
+    window: int = _h(100, "episodes in the moving average")
+    checkpoint_every: int = _h(50, "episodes between checkpoints")

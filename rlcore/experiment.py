@@ -1,0 +1,63 @@
+"""The registry: experiment name -> env factory, algorithms, presets, solved threshold.
+
+TensorFlow-free, so ``main.py list`` and env-pool workers import it cheaply. Experiment packages
+are imported lazily by module path.
+"""
+from __future__ import annotations
+
+import importlib
+from dataclasses import dataclass, field
+from typing import Callable
+
+from rlcore.errors import UserError
+
+#: experiment name -> module holding ``EXPERIMENT``
+EXPERIMENT_MODULES = {
+    "lunar_lander": "lunar_lander.experiment",
+}
+
+
+@dataclass(frozen=True)
+class AlgoSpec:
+    """One algorithm of an experiment: which trainer runs it and its named presets."""
+    name: str
+    kind: str  # trainer / policy family: "dqn" | "a2c"
+    description: str
+    presets: dict  # preset name -> config dataclass instance
+    default_preset: str = "default"
+
+
+@dataclass(frozen=True)
+class Experiment:
+    name: str
+    description: str
+    make_env: Callable  # make_env(render_mode=None, max_episode_steps=None) -> gymnasium.Env
+    algos: dict[str, AlgoSpec]
+    solved_score: float
+    eval_seed_base: int = 1_000_000  # evaluation seeds start here; training never uses them
+    video_fps: int = 30
+    extra: dict = field(default_factory=dict)
+
+    def algo(self, name: str) -> AlgoSpec:
+        if name not in self.algos:
+            raise UserError(f"unknown algorithm {name!r} for {self.name}; choose one of "
+                            f"{', '.join(self.algos)}")
+        return self.algos[name]
+
+    def preset(self, algo: str, preset: str | None):
+        spec = self.algo(algo)
+        preset = preset or spec.default_preset
+        if preset not in spec.presets:
+            raise UserError(f"unknown preset {preset!r} for {self.name} {algo}; choose one of "
+                            f"{', '.join(spec.presets)}")
+        return spec.presets[preset]
+
+
+def experiment_names() -> list[str]:
+    return list(EXPERIMENT_MODULES)
+
+
+def get_experiment(name: str) -> Experiment:
+    if name not in EXPERIMENT_MODULES:
+        raise UserError(f"unknown experiment {name!r}; choose one of {', '.join(EXPERIMENT_MODULES)}")
+    return importlib.import_module(EXPERIMENT_MODULES[name]).EXPERIMENT

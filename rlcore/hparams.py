@@ -1,0 +1,80 @@
+"""Hyperparameter dataclasses <-> command line.
+
+Every field of a config dataclass becomes a ``--field-name VALUE`` option with the field's
+``help`` metadata as its help text, so no flag is written by hand.
+"""
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import typing
+
+from rlcore.errors import UserError
+
+
+def _parse_bool(text: str) -> bool:
+    lowered = text.strip().lower()
+    if lowered in ("1", "true", "yes", "on"):
+        return True
+    if lowered in ("0", "false", "no", "off"):
+        return False
+    raise ValueError(f"expected true/false, got {text!r}")
+
+
+def _parser_for(annotation) -> typing.Callable[[str], object]:
+    """Turn a field's type annotation into a function parsing its CLI text."""
+    if annotation is bool:
+        return _parse_bool
+    if annotation in (int, float, str):
+        return annotation
+    if typing.get_origin(annotation) is tuple:
+        (item,) = {a for a in typing.get_args(annotation) if a is not Ellipsis}
+        return lambda text: tuple(item(part) for part in text.split(",") if part.strip())
+    raise TypeError(f"unsupported hyperparameter type {annotation!r}")
+
+
+def field_types(cls) -> dict[str, typing.Callable[[str], object]]:
+    hints = typing.get_type_hints(cls)
+    return {f.name: _parser_for(hints[f.name]) for f in dataclasses.fields(cls)}
+
+
+def add_arguments(parser: argparse.ArgumentParser, cfg) -> None:
+    """Add one ``--name`` option per field of dataclass instance ``cfg`` (default: keep the preset)."""
+    group = parser.add_argument_group(f"hyperparameters ({type(cfg).__name__}; defaults shown are the preset's)")
+    types = field_types(type(cfg))
+    for f in dataclasses.fields(cfg):
+        value = getattr(cfg, f.name)
+        shown = ",".join(map(str, value)) if isinstance(value, tuple) else value
+        group.add_argument(f"--{f.name.replace('_', '-')}", dest=f"hp_{f.name}", default=None,
+                           type=types[f.name], metavar=type(value).__name__.upper(),
+                           help=f"{f.metadata.get('help', '')} (default: {shown})")
+
+
+def overrides_from_args(args: argparse.Namespace) -> dict:
+    """The hyperparameters the user set on the command line."""
+    return {k[3:]: v for k, v in vars(args).items() if k.startswith("hp_") and v is not None}
+
+
+def apply_overrides(cfg, overrides: dict):
+    """A copy of ``cfg`` with ``overrides`` applied; unknown names are a :class:`UserError`."""
+    names = {f.name for f in dataclasses.fields(cfg)}
+    unknown = sorted(set(overrides) - names)
+    if unknown:
+        raise UserError(f"unknown hyperparameter(s) {', '.join(unknown)} for {type(cfg).__name__}; "
+                        f"known: {', '.join(sorted(names))}")
+    return dataclasses.replace(cfg, **overrides)
+
+
+def to_dict(cfg) -> dict:
+    return {k: list(v) if isinstance(v, tuple) else v for k, v in dataclasses.asdict(cfg).items()}
+
+
+def from_dict(cls, data: dict):
+    """Rebuild a config from :func:`to_dict` output (e.g. from a ``meta.json``)."""
+    hints = typing.get_type_hints(cls)
+    kwargs = {}
+    for f in dataclasses.fields(cls):
+        if f.name in data:
+            value = data[f.name]
+            kwargs[f.name] = tuple(value) if typing.get_origin(hints[f.name]) is tuple else value
+    return cls(**kwargs)

@@ -1,0 +1,34 @@
+"""Training plots as PNG (matplotlib, no display needed)."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import pandas as pd  # noqa: E402
+
+from rlcore.atomic import atomic_path  # noqa: E402
+
+
+def plot_episode_scores(csv_path: str | Path, png_path: str | Path, title: str,
+                        solved_score: float | None = None) -> Path:
+    """Score per episode, its moving average and the solved line, as in article 000's figure."""
+    df = pd.read_csv(csv_path)
+    fig, ax = plt.subplots(figsize=(9, 5))
+    ax.plot(df["episode"], df["total_points"], color="tab:blue", linewidth=1, alpha=0.6, label="Score")
+    ax.plot(df["episode"], df["av_latest_points"], color="tab:orange", linewidth=2, linestyle="--",
+            label="Average score (last 100)")
+    if solved_score is not None:
+        ax.axhline(solved_score, color="tab:red", linewidth=2, linestyle="--", label="Solved requirement")
+    ax.set_xlabel("episode")
+    ax.set_ylabel("return")
+    ax.set_title(title)
+    ax.grid(alpha=0.3)
+    ax.legend(loc="lower right")
+    fig.tight_layout()
+    with atomic_path(png_path) as tmp:
+        fig.savefig(tmp, dpi=100)
+    plt.close(fig)
+    return Path(png_path)

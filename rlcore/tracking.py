@@ -1,0 +1,96 @@
+"""One interface for run metrics: wandb (online / offline / off), a CSV, and a PNG plot.
+
+wandb mode ``auto`` means online when the user is logged in (``WANDB_API_KEY`` or a netrc entry),
+offline otherwise. Never a prompt; with no network, ``online`` fails fast with one clear line.
+"""
+from __future__ import annotations
+
+import csv
+import math
+import netrc
+import os
+from pathlib import Path
+
+from rlcore.errors import UserError
+
+WANDB_MODES = ("auto", "online", "offline", "off")
+WANDB_PROJECT = "deep-rl-tf2"
+
+
+def wandb_logged_in() -> bool:
+    if os.environ.get("WANDB_API_KEY"):
+        return True
+    try:
+        return netrc.netrc().authenticators("api.wandb.ai") is not None
+    except (FileNotFoundError, netrc.NetrcParseError, OSError):
+        return False
+
+
+def resolve_wandb_mode(requested: str) -> str:
+    """'auto' -> 'online' if logged in else 'offline'; 'off' -> 'disabled'."""
+    if requested not in WANDB_MODES:
+        raise UserError(f"unknown wandb mode {requested!r}; choose one of {', '.join(WANDB_MODES)}")
+    if requested == "auto":
+        return "online" if wandb_logged_in() else "offline"
+    return "disabled" if requested == "off" else requested
+
+
+class Tracker:
+    """Logs one row of numbers at a time to wandb and ``<run_dir>/metrics.csv``.
+
+    The CSV columns are fixed by the first row; resuming appends to the same file.
+    """
+
+    def __init__(self, run_dir: str | Path, run_name: str, config: dict, wandb_mode: str = "auto",
+                 wandb_id: str | None = None):
+        self.run_dir = Path(run_dir)
+        self.run_dir.mkdir(parents=True, exist_ok=True)
+        self.csv_path = self.run_dir / "metrics.csv"
+        self._csv_file = None
+        self._writer = None
+        self.wandb_run = None
+        mode = resolve_wandb_mode(wandb_mode)
+        if mode != "disabled":
+            self.wandb_run = self._start_wandb(mode, run_name, config, wandb_id)
+        self.wandb_id = self.wandb_run.id if self.wandb_run else None
+
+    def _start_wandb(self, mode: str, run_name: str, config: dict, wandb_id: str | None):
+        os.environ.setdefault("WANDB_SILENT", "true")
+        import wandb
+
+        settings = wandb.Settings(silent=True, init_timeout=30, x_disable_stats=True, disable_git=True,
+                                  console="off")
+        try:
+            return wandb.init(project=WANDB_PROJECT, name=run_name, config=config, mode=mode,
+                              dir=str(self.run_dir), id=wandb_id, resume="allow" if wandb_id else None,
+                              settings=settings)
+        except Exception as exc:  # no network, bad key, service failure
+            reason = str(exc).splitlines()[0][:200] if str(exc) else type(exc).__name__
+            raise UserError(f"wandb could not start in {mode} mode ({reason}); "
+                            "use --wandb offline (sync later with `wandb sync`) or --wandb off")
+
+    def log(self, row: dict) -> None:
+        if self._writer is None:
+            exists = self.csv_path.exists() and self.csv_path.stat().st_size > 0
+            if exists:
+                with open(self.csv_path, newline="") as f:
+                    fieldnames = next(csv.reader(f))
+            else:
+                fieldnames = list(row)
+            self._csv_file = open(self.csv_path, "a", newline="")
+            self._writer = csv.DictWriter(self._csv_file, fieldnames=fieldnames, extrasaction="ignore")
+            if not exists:
+                self._writer.writeheader()
+        self._writer.writerow(row)
+        self._csv_file.flush()
+        if self.wandb_run is not None:
+            self.wandb_run.log({k: v for k, v in row.items()
+                                if isinstance(v, (int, float)) and not math.isnan(v)})
+
+    def close(self) -> None:
+        if self._csv_file is not None:
+            self._csv_file.close()
+            self._csv_file, self._writer = None, None
+        if self.wandb_run is not None:
+            self.wandb_run.finish()
+            self.wandb_run = None

@@ -1,0 +1,1 @@
+"""Training loops, one per algorithm family, sharing :mod:`rlcore.trainers.session`."""

@@ -1,0 +1,85 @@
+"""Episode loop for the Q-learning agents (DQN, Double, Dueling, Dueling Double)."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import keras
+import numpy as np
+import tensorflow as tf
+
+from rlcore.agents.dqn import DQNAgent
+from rlcore.checkpoint import load_checkpoint, save_checkpoint
+from rlcore.errors import UserError
+from rlcore.replay import ReplayMemory
+from rlcore.trainers.session import RunSpec, TrainingSession, check_resumable
+
+
+def train(spec: RunSpec) -> Path:
+    """Train until the stop score, episode or step budget; return the model folder."""
+    cfg = spec.config
+    keras.utils.set_random_seed(spec.seed)
+    env = spec.experiment.make_env(max_episode_steps=cfg.max_episode_steps)
+    obs_dim, n_actions = env.observation_space.shape[0], int(env.action_space.n)
+    agent = DQNAgent(obs_dim, n_actions, cfg)
+    memory = ReplayMemory(cfg.buffer_size, (obs_dim,))
+    rng = np.random.default_rng(spec.seed)
+    epsilon = cfg.eps_start
+
+    state = check_resumable(spec) if spec.resume else None
+    if state is not None:
+        state, arrays = load_checkpoint(spec.run_dir / "checkpoint.npz", agent.models(), agent.optimizers())
+        memory.load_state_dict({k[len("replay/"):]: v for k, v in arrays.items() if k.startswith("replay/")})
+        rng.bit_generator.state = state["rng"]
+        epsilon = state["epsilon"]
+        agent.sync_policy_weights()
+    session = TrainingSession(spec, state)
+    grad_steps = int(state["grad_steps"]) if state else 0
+
+    def checkpoint():
+        save_checkpoint(session.checkpoint_path, agent.models(), agent.optimizers(),
+                        session.state(epsilon=epsilon, grad_steps=grad_steps, rng=rng.bit_generator.state),
+                        {f"replay/{k}": v for k, v in memory.state_dict().items()})
+
+    first_seed = spec.seed + session.book.episodes  # a resumed run reseeds from its episode count
+    with session.interruptible():
+        while not session.should_stop():
+            obs, _ = env.reset(seed=first_seed)
+            first_seed = None  # later episodes continue the env's own RNG
+            episode_return, losses = 0.0, []
+            while True:
+                action = agent.act(obs, epsilon, rng)
+                next_obs, reward, terminated, truncated, _ = env.step(action)
+                memory.add(obs, action, reward, next_obs, terminated)
+                session.env_steps += 1
+                episode_return += reward
+                obs = next_obs
+                if session.env_steps % cfg.learn_every == 0 and len(memory) >= max(cfg.batch_size,
+                                                                                    cfg.learning_starts):
+                    losses.append(_train_step(agent, memory.sample(cfg.batch_size, rng), session.env_steps))
+                    grad_steps += 1
+                if terminated or truncated or session.stop_requested:
+                    break
+            if session.stop_requested:  # partial episode: not counted; its transitions stay in replay
+                break
+            epsilon = max(cfg.eps_end, epsilon * cfg.eps_decay)
+            mean_losses = {k: float(np.mean([l[k] for l in losses])) if losses else float("nan")
+                           for k in ("loss", "q_mean")}
+            session.end_episode(episode_return, {"epsilon": epsilon, "grad_steps": grad_steps, **mean_losses})
+            if session.book.episodes % cfg.checkpoint_every == 0:
+                checkpoint()
+    env.close()
+    if session.stop_requested:
+        checkpoint()
+        raise session.interrupted()
+    checkpoint()
+    return session.finish(lambda folder: [agent.save(folder)])
+
+
+def _train_step(agent: DQNAgent, batch, env_steps: int) -> dict:
+    try:
+        return agent.train_step(*batch)
+    except tf.errors.InvalidArgumentError as exc:
+        if "DQN loss" in str(exc):
+            raise UserError(f"training diverged: the loss became NaN/Inf at env step {env_steps}; "
+                            "lower --lr or resume from the last checkpoint") from None
+        raise

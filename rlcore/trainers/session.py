@@ -1,0 +1,220 @@
+"""What every training run shares: run folder, episode book-keeping, console/progress output,
+tracking, checkpoint cadence, Ctrl-C handling and the final model folder with its ``meta.json``.
+"""
+from __future__ import annotations
+
+import contextlib
+import platform
+import shlex
+import signal
+import sys
+import time
+from dataclasses import dataclass, field
+from datetime import datetime, timezone
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from rlcore.atomic import write_json
+from rlcore.checkpoint import read_checkpoint_state
+from rlcore.errors import UserError
+from rlcore.hparams import to_dict
+from rlcore.plotting import plot_episode_scores
+from rlcore.tracking import Tracker
+
+RUNS_DIR = Path("runs")
+CHECKPOINT_FILE = "checkpoint.npz"
+
+
+class Interrupted(Exception):
+    """Raised after Ctrl-C once the checkpoint is safely written."""
+
+    def __init__(self, checkpoint: Path):
+        super().__init__(f"interrupted; checkpoint saved to {checkpoint}; continue with --resume {checkpoint.parent}")
+        self.checkpoint = checkpoint
+
+
+@dataclass
+class RunSpec:
+    """Everything that defines a training run (what ``main.py train`` parsed)."""
+    experiment: object  # rlcore.experiment.Experiment
+    algo: str
+    preset: str
+    config: object
+    seed: int
+    wandb_mode: str = "auto"
+    run_dir: Path | None = None
+    resume: bool = False
+    command: str = field(default_factory=lambda: " ".join(shlex.quote(a) for a in ["python", *sys.argv]))
+    progress: bool = True
+
+    @property
+    def kind(self) -> str:
+        return self.experiment.algo(self.algo).kind
+
+
+def new_run_dir(experiment: str, algo: str, seed: int) -> Path:
+    stamp = datetime.now().strftime("%Y%m%d-%H%M%S")
+    return RUNS_DIR / f"{experiment}__{algo}__{seed}__{stamp}"
+
+
+def latest_run_dir(experiment: str, algo: str) -> Path:
+    runs = sorted(RUNS_DIR.glob(f"{experiment}__{algo}__*/{CHECKPOINT_FILE}"), key=lambda p: p.stat().st_mtime)
+    if not runs:
+        raise UserError(f"no run of {experiment} {algo} with a checkpoint under {RUNS_DIR}/ to resume")
+    return runs[-1].parent
+
+
+def check_resumable(spec: RunSpec) -> dict:
+    """The checkpoint's state, after checking it belongs to this experiment and algorithm."""
+    state = read_checkpoint_state(spec.run_dir / CHECKPOINT_FILE)
+    found = (state.get("experiment"), state.get("algo"))
+    if found != (spec.experiment.name, spec.algo):
+        raise UserError(f"checkpoint in {spec.run_dir} is from {found[0]} {found[1]}, "
+                        f"not {spec.experiment.name} {spec.algo}; pick the matching run")
+    return state
+
+
+def package_versions() -> dict:
+    import gymnasium
+    import keras
+    import tensorflow as tf
+    return {"python": platform.python_version(), "tensorflow": tf.__version__, "keras": keras.__version__,
+            "gymnasium": gymnasium.__version__, "numpy": np.__version__}
+
+
+class EpisodeBook:
+    """Episode returns, the moving average, and the article's console line and wandb keys."""
+
+    def __init__(self, window: int, solved_score: float, returns: list[float] | None = None):
+        self.window, self.solved_score = window, solved_score
+        self.returns: list[float] = list(returns or [])
+        self.solved_episode: int | None = None
+
+    @property
+    def episodes(self) -> int:
+        return len(self.returns)
+
+    @property
+    def average(self) -> float:
+        return float(np.mean(self.returns[-self.window:])) if self.returns else float("nan")
+
+    def full_window(self) -> bool:
+        return len(self.returns) >= self.window
+
+    def add(self, episode_return: float) -> dict:
+        """Record one episode; return the article's per-episode metrics."""
+        self.returns.append(float(episode_return))
+        if self.solved_episode is None and self.full_window() and self.average >= self.solved_score:
+            self.solved_episode = self.episodes
+            tqdm.write(f"\nEnvironment solved in {self.episodes} episodes!")
+        if self.episodes % self.window == 0:
+            tqdm.write(f"Episode {self.episodes} | Total point average of the last {self.window} "
+                       f"episodes: {self.average:.2f}")
+        return {"episode": self.episodes, "total_points": float(episode_return),
+                "av_latest_points": self.average, "target_ave_scores": self.solved_score}
+
+
+class TrainingSession:
+    """Context for one run: owns the tracker, progress bar, book and the Ctrl-C flag."""
+
+    def __init__(self, spec: RunSpec, resumed_state: dict | None = None):
+        self.spec = spec
+        exp, cfg = spec.experiment, spec.config
+        self.run_dir = spec.run_dir
+        self.run_dir.mkdir(parents=True, exist_ok=True)
+        state = resumed_state or {}
+        self.book = EpisodeBook(cfg.window, exp.solved_score, state.get("returns"))
+        self.book.solved_episode = state.get("solved_episode")
+        self.env_steps = int(state.get("env_steps", 0))
+        self.wall_seconds = float(state.get("wall_seconds", 0.0))
+        self._started = time.perf_counter()
+        self._steps_at_start = self.env_steps
+        self.stop_requested = False
+        self.tracker = Tracker(self.run_dir, self.run_dir.name, self.describe(), spec.wandb_mode,
+                               wandb_id=state.get("wandb_id"))
+        self.progress = tqdm(total=cfg.max_episodes, initial=self.book.episodes, unit="ep",
+                             disable=not spec.progress, dynamic_ncols=True, leave=True)
+
+    # ------------------------------------------------------------ bookkeeping
+    def describe(self) -> dict:
+        s = self.spec
+        return {"experiment": s.experiment.name, "algo": s.algo, "kind": s.kind, "preset": s.preset,
+                "seed": s.seed, "config": to_dict(s.config)}
+
+    def elapsed(self) -> float:
+        return self.wall_seconds + time.perf_counter() - self._started
+
+    def end_episode(self, episode_return: float, extra: dict) -> None:
+        """Log one finished episode to the book, CSV/wandb and the progress bar."""
+        row = self.book.add(episode_return)
+        row.update(env_steps=self.env_steps, wall_seconds=round(self.elapsed(), 2), **extra)
+        self.tracker.log(row)
+        rate = (self.env_steps - self._steps_at_start) / max(time.perf_counter() - self._started, 1e-9)
+        self.progress.update(1)
+        self.progress.set_postfix(avg100=f"{self.book.average:.1f}", steps=self.env_steps,
+                                  sps=f"{rate:.0f}", refresh=False)
+
+    def should_stop(self) -> bool:
+        cfg = self.spec.config
+        if self.stop_requested:
+            return True
+        if self.book.episodes >= cfg.max_episodes:
+            return True
+        if cfg.max_env_steps and self.env_steps >= cfg.max_env_steps:
+            return True
+        return self.book.full_window() and self.book.average >= cfg.stop_score
+
+    def state(self, **extra) -> dict:
+        """JSON-able counters for a checkpoint."""
+        return {**self.describe(), "returns": self.book.returns, "solved_episode": self.book.solved_episode,
+                "env_steps": self.env_steps, "wall_seconds": self.elapsed(),
+                "wandb_id": self.tracker.wandb_id, **extra}
+
+    @property
+    def checkpoint_path(self) -> Path:
+        return self.run_dir / CHECKPOINT_FILE
+
+    # --------------------------------------------------------------- Ctrl-C
+    @contextlib.contextmanager
+    def interruptible(self):
+        """First Ctrl-C asks the loop to stop at a safe point (it checkpoints); the second aborts."""
+        def handler(signum, frame):
+            if self.stop_requested:
+                raise KeyboardInterrupt
+            self.stop_requested = True
+            tqdm.write("\nCtrl-C: stopping at the next safe point and saving a checkpoint "
+                       "(press again to abort without saving)")
+        previous = signal.signal(signal.SIGINT, handler)
+        try:
+            yield
+        finally:
+            signal.signal(signal.SIGINT, previous)
+
+    # ------------------------------------------------------------- finishing
+    def finish(self, save_models) -> Path:
+        """Write the model folder: ``save_models(folder)`` writes the ``.h5`` files, then meta + plot."""
+        self.progress.close()
+        self.tracker.close()
+        model_dir = self.run_dir / "model"
+        model_dir.mkdir(parents=True, exist_ok=True)
+        files = [p.name for p in save_models(model_dir)]
+        exp, s = self.spec.experiment, self.spec
+        plot_name = f"{exp.extra.get('plot_prefix', exp.name)}_Train_{s.algo}.png"
+        plot_episode_scores(self.tracker.csv_path, model_dir / plot_name,
+                            f"{exp.name} {s.algo} ({s.preset} preset, seed {s.seed})", exp.solved_score)
+        (model_dir / "metrics.csv").write_bytes(self.tracker.csv_path.read_bytes())
+        meta = {**self.describe(), "command": s.command, "env_steps": self.env_steps,
+                "episodes": self.book.episodes, "wall_seconds": round(self.elapsed(), 1),
+                "solved_episode": self.book.solved_episode,
+                "final_average": round(self.book.average, 2), "model_files": files,
+                "plot": plot_name, "versions": package_versions(),
+                "finished": datetime.now(timezone.utc).isoformat(timespec="seconds")}
+        write_json(model_dir / "meta.json", meta)
+        return model_dir
+
+    def interrupted(self) -> Interrupted:
+        self.progress.close()
+        self.tracker.close()
+        return Interrupted(self.checkpoint_path)
