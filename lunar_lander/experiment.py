@@ -25,7 +25,8 @@ def make_env(render_mode: str | None = None, max_episode_steps: int | None = 100
 # learn every 4 steps, tau 1e-3, epsilon 1.0 * 0.995^episode down to 0.01.
 _DQN_ARTICLE = DQNConfig()
 # Tuned for speed: see README "Presets" for the measurements behind these values.
-_DQN_DEFAULT = dataclasses.replace(_DQN_ARTICLE, eps_decay=0.98, tau=5e-3, lr=5e-4, stop_score=250.0)
+_DQN_DEFAULT = dataclasses.replace(_DQN_ARTICLE, eps_decay=0.98, tau=5e-3, lr=5e-4, stop_score=250.0,
+                                   updates_per_call=4)
 
 
 def _dqn_presets(**switches) -> dict:

@@ -26,6 +26,8 @@ class DQNConfig:
     batch_size: int = _h(64, "minibatch size")
     learn_every: int = _h(4, "one gradient step every this many env steps")
     learning_starts: int = _h(64, "env steps collected before the first gradient step")
+    updates_per_call: int = _h(1, "gradient steps batched into one compiled call (every "
+                                  "learn_every * this env steps); >1 trades update lag for speed")
     tau: float = _h(1e-3, "soft target update rate, applied after every gradient step")
     eps_start: float = _h(1.0, "initial exploration rate")
     eps_end: float = _h(0.01, "final exploration rate")

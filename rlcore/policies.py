@@ -4,6 +4,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
+
 from rlcore.errors import UserError
 from rlcore.experiment import get_experiment
 
@@ -36,10 +38,26 @@ def load_policy(model_dir: str | Path, experiment: str | None = None, algo: str 
     env = exp.make_env()
     obs_dim, n_actions = env.observation_space.shape[0], int(env.action_space.n)
     env.close()
-    if spec.kind == "dqn":
-        from rlcore.agents.dqn import GreedyQPolicy
-        return exp, meta, GreedyQPolicy(model_dir, obs_dim, n_actions)
-    if spec.kind == "a2c":
-        from rlcore.agents.a2c import GreedyActorPolicy
-        return exp, meta, GreedyActorPolicy(model_dir, obs_dim, n_actions)
-    raise UserError(f"no policy loader for algorithm kind {spec.kind!r}")
+    if spec.kind not in POLICY_FILES:
+        raise UserError(f"no policy loader for algorithm kind {spec.kind!r}")
+    return exp, meta, GreedyPolicy(Path(model_dir) / POLICY_FILES[spec.kind], obs_dim, n_actions)
+
+
+#: algorithm kind -> the saved network whose argmax is the greedy action
+POLICY_FILES = {"dqn": "q_network.h5", "a2c": "actor.h5"}
+
+
+class GreedyPolicy:
+    """argmax over a saved model's outputs (Q-values or action probabilities), batched."""
+
+    def __init__(self, model_path: Path, obs_dim: int, n_actions: int):
+        import tensorflow as tf
+
+        from rlcore.models import load_keras_model
+
+        self.model = load_keras_model(model_path, obs_dim, n_actions)
+        self._greedy = tf.function(lambda obs: tf.argmax(self.model(obs), axis=1, output_type=tf.int32),
+                                   input_signature=[tf.TensorSpec([None, obs_dim], tf.float32)])
+
+    def __call__(self, obs: np.ndarray) -> np.ndarray:
+        return self._greedy(np.asarray(obs, np.float32)).numpy()

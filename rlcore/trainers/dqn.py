@@ -40,6 +40,7 @@ def train(spec: RunSpec) -> Path:
                         session.state(epsilon=epsilon, grad_steps=grad_steps, rng=rng.bit_generator.state),
                         {f"replay/{k}": v for k, v in memory.state_dict().items()})
 
+    update_period = cfg.learn_every * cfg.updates_per_call
     first_seed = spec.seed + session.book.episodes  # a resumed run reseeds from its episode count
     with session.interruptible():
         while not session.should_stop():
@@ -53,10 +54,12 @@ def train(spec: RunSpec) -> Path:
                 session.env_steps += 1
                 episode_return += reward
                 obs = next_obs
-                if session.env_steps % cfg.learn_every == 0 and len(memory) >= max(cfg.batch_size,
-                                                                                    cfg.learning_starts):
-                    losses.append(_train_step(agent, memory.sample(cfg.batch_size, rng), session.env_steps))
-                    grad_steps += 1
+                if session.env_steps % update_period == 0 and len(memory) >= max(cfg.batch_size,
+                                                                                  cfg.learning_starts):
+                    batch = memory.sample(cfg.batch_size * cfg.updates_per_call, rng)
+                    stacked = [x.reshape(cfg.updates_per_call, cfg.batch_size, *x.shape[1:]) for x in batch]
+                    losses.append(_train_steps(agent, stacked, session.env_steps))
+                    grad_steps += cfg.updates_per_call
                 if terminated or truncated or session.stop_requested:
                     break
             if session.stop_requested:  # partial episode: not counted; its transitions stay in replay
@@ -75,9 +78,9 @@ def train(spec: RunSpec) -> Path:
     return session.finish(lambda folder: [agent.save(folder)])
 
 
-def _train_step(agent: DQNAgent, batch, env_steps: int) -> dict:
+def _train_steps(agent: DQNAgent, batch, env_steps: int) -> dict:
     try:
-        return agent.train_step(*batch)
+        return agent.train_steps(*batch)
     except tf.errors.InvalidArgumentError as exc:
         if "DQN loss" in str(exc):
             raise UserError(f"training diverged: the loss became NaN/Inf at env step {env_steps}; "

@@ -135,7 +135,7 @@ class TrainingSession:
         self.tracker = Tracker(self.run_dir, self.run_dir.name, self.describe(), spec.wandb_mode,
                                wandb_id=state.get("wandb_id"))
         self.progress = tqdm(total=cfg.max_episodes, initial=self.book.episodes, unit="ep",
-                             disable=not spec.progress, dynamic_ncols=True, leave=True)
+                             disable=None if spec.progress else True, dynamic_ncols=True, leave=True)
 
     # ------------------------------------------------------------ bookkeeping
     def describe(self) -> dict:

@@ -1,0 +1,91 @@
+"""Rollout loop for A2C over ``num_envs`` in-process envs (Gymnasium's SyncVectorEnv)."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import gymnasium as gym
+import keras
+import numpy as np
+import tensorflow as tf
+
+from rlcore.agents.a2c import A2CAgent
+from rlcore.checkpoint import load_checkpoint, save_checkpoint
+from rlcore.errors import UserError
+from rlcore.trainers.session import RunSpec, TrainingSession, check_resumable
+
+
+def bootstrap_observations(next_obs: np.ndarray, infos: dict) -> np.ndarray:
+    """``next_obs`` with each finished env's row replaced by its final observation.
+
+    With same-step auto-reset, ``next_obs`` of a finished env is already the next episode's first
+    observation; a truncated episode must bootstrap from where it actually stopped.
+    """
+    if "_final_obs" not in infos:
+        return next_obs
+    boot = next_obs.copy()
+    for i in np.flatnonzero(infos["_final_obs"]):
+        boot[i] = infos["final_obs"][i]
+    return boot
+
+
+def train(spec: RunSpec) -> Path:
+    cfg = spec.config
+    keras.utils.set_random_seed(spec.seed)
+    envs = gym.vector.SyncVectorEnv(
+        [lambda: spec.experiment.make_env(max_episode_steps=cfg.max_episode_steps)] * cfg.num_envs,
+        autoreset_mode=gym.vector.AutoresetMode.SAME_STEP)
+    obs_dim, n_actions = envs.single_observation_space.shape[0], int(envs.single_action_space.n)
+    agent = A2CAgent(obs_dim, n_actions, cfg)
+    rng = np.random.default_rng(spec.seed)
+
+    state = check_resumable(spec) if spec.resume else None
+    if state is not None:
+        state, _ = load_checkpoint(spec.run_dir / "checkpoint.npz", agent.models(), agent.optimizers())
+        rng.bit_generator.state = state["rng"]
+        agent.sync_policy_weights()
+    session = TrainingSession(spec, state)
+
+    def checkpoint():
+        save_checkpoint(session.checkpoint_path, agent.models(), agent.optimizers(),
+                        session.state(rng=rng.bit_generator.state))
+
+    t, n = cfg.n_steps, cfg.num_envs
+    buf_obs = np.zeros((t, n, obs_dim), np.float32)
+    buf_next = np.zeros((t, n, obs_dim), np.float32)
+    buf_actions = np.zeros((t, n), np.int32)
+    buf_rewards, buf_term, buf_done = (np.zeros((t, n), np.float32) for _ in range(3))
+    running = np.zeros(n)
+    losses = {"actor_loss": float("nan"), "critic_loss": float("nan"), "entropy": float("nan")}
+    # a resumed run starts fresh episodes, reseeded from its episode count
+    obs, _ = envs.reset(seed=[spec.seed * 1000 + session.book.episodes + i for i in range(n)])
+    next_checkpoint = (session.book.episodes // cfg.checkpoint_every + 1) * cfg.checkpoint_every
+    with session.interruptible():
+        while not session.should_stop():
+            for step in range(t):
+                actions = agent.act(obs, rng)
+                next_obs, rewards, terminated, truncated, infos = envs.step(actions)
+                done = terminated | truncated
+                buf_obs[step], buf_actions[step], buf_rewards[step] = obs, actions, rewards
+                buf_next[step] = bootstrap_observations(next_obs, infos)
+                buf_term[step], buf_done[step] = terminated, done
+                session.env_steps += n
+                running += rewards
+                for i in np.flatnonzero(done):
+                    session.end_episode(running[i], losses)
+                    running[i] = 0.0
+                obs = next_obs
+            try:
+                losses = agent.update(buf_obs, buf_actions, buf_rewards, buf_next, buf_term, buf_done)
+            except tf.errors.InvalidArgumentError as exc:
+                if "A2C" not in str(exc):
+                    raise
+                raise UserError(f"training diverged: NaN/Inf in the A2C loss at env step {session.env_steps}; "
+                                "lower the learning rates or resume from the last checkpoint") from None
+            if session.book.episodes >= next_checkpoint:
+                checkpoint()
+                next_checkpoint += cfg.checkpoint_every
+    envs.close()
+    checkpoint()
+    if session.stop_requested:
+        raise session.interrupted()
+    return session.finish(agent.save)
