@@ -23,7 +23,8 @@ def evaluate(experiment, policy, episodes: int = 100, seed_base: int | None = No
     next_seed = width
     running = np.zeros(width)
     active = np.ones(width, bool)  # envs still owed an episode
-    bar = tqdm(total=episodes, unit="ep", desc="evaluate", disable=None if progress else True, leave=False)
+    bar = tqdm(total=episodes, unit="ep", desc="evaluate", disable=None if progress else True,
+               leave=False)
     while active.any():
         obs, reward, terminated, truncated, _ = envs.step(policy(obs))
         running += reward

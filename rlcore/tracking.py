@@ -58,7 +58,8 @@ class Tracker:
         os.environ.setdefault("WANDB_SILENT", "true")
         import wandb
 
-        settings = wandb.Settings(silent=True, init_timeout=float(os.environ.get("WANDB_INIT_TIMEOUT", 30)), x_disable_stats=True, disable_git=True,
+        timeout = float(os.environ.get("WANDB_INIT_TIMEOUT", 30))
+        settings = wandb.Settings(silent=True, init_timeout=timeout, x_disable_stats=True, disable_git=True,
                                   console="off")
         try:
             return wandb.init(project=WANDB_PROJECT, name=run_name, config=config, mode=mode,

@@ -1,0 +1,60 @@
+"""The algorithms' math written out in plain numpy, loop by loop, as the tests' ground truth."""
+import numpy as np
+
+
+def dqn_td_target(reward, terminated, q_next_target, q_next_online, gamma, double):
+    """r + gamma * Q_target(s', a*) (no bootstrap if terminated); a* from online net if double."""
+    out = np.zeros(len(reward))
+    for i in range(len(reward)):
+        chooser = q_next_online[i] if double else q_next_target[i]
+        best = int(np.argmax(chooser))
+        out[i] = reward[i] + (0.0 if terminated[i] else gamma * q_next_target[i][best])
+    return out
+
+
+def dueling_combine(value, advantage):
+    """Q(s,a) = V(s) + A(s,a) - mean over a of A(s,a), row by row."""
+    q = np.zeros_like(advantage)
+    for i in range(advantage.shape[0]):
+        q[i] = value[i, 0] + advantage[i] - advantage[i].mean()
+    return q
+
+
+def gae(rewards, values, next_values, terminated, dones, gamma, lam):
+    """Generalized advantage estimation over a [T, N] rollout, one env and one step at a time."""
+    t_len, n = rewards.shape
+    adv = np.zeros((t_len, n))
+    for env in range(n):
+        running = 0.0
+        for t in reversed(range(t_len)):
+            bootstrap = 0.0 if terminated[t, env] else gamma * next_values[t, env]
+            delta = rewards[t, env] + bootstrap - values[t, env]
+            if dones[t, env]:
+                running = 0.0
+            running = delta + gamma * lam * running
+            adv[t, env] = running
+    return adv
+
+
+def one_step_td(rewards, next_values, terminated, gamma):
+    """The article's td_target: r if the episode terminated, else r + gamma V(s')."""
+    return np.where(terminated, rewards, rewards + gamma * next_values)
+
+
+def n_step_returns(rewards, bootstrap_value, dones, gamma):
+    """R_t = r_t + gamma R_{t+1}, reset at episode ends, seeded with V(s_T): article 002's returns."""
+    t_len, n = rewards.shape
+    returns = np.zeros((t_len, n))
+    running = np.array(bootstrap_value, dtype=float)
+    for t in reversed(range(t_len)):
+        running = rewards[t] + gamma * running * (1.0 - dones[t])
+        returns[t] = running
+    return returns
+
+
+def actor_loss(probs, actions, advantages, entropy_coef):
+    """mean(-log pi(a|s) * A) - c * mean entropy."""
+    n = len(actions)
+    ce = np.array([-np.log(probs[i, actions[i]]) for i in range(n)])
+    entropy = np.array([-(probs[i] * np.log(probs[i])).sum() for i in range(n)])
+    return (ce * advantages).mean() - entropy_coef * entropy.mean(), entropy.mean()
