@@ -171,11 +171,18 @@ def cmd_render(args) -> int:
 
 
 # ------------------------------------------------------------------ parser
+class _Parser(argparse.ArgumentParser):
+    """argparse that reports a bad command line as one line (and exit status 2)."""
+
+    def error(self, message):
+        self.exit(2, f"error: {message} (see `{self.prog} --help`)\n")
+
+
 def build_parser(argv: list[str]) -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="main.py", description="TensorFlow 2 / Keras deep RL: train, evaluate and render agents.",
         epilog="`main.py list` shows experiments, algorithms, presets and shipped models.")
-    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND", parser_class=_Parser)
 
     sub.add_parser("list", help="experiments, algorithms, presets and shipped models with their scores")
 

@@ -9,6 +9,7 @@ import csv
 import math
 import netrc
 import os
+import sys
 from pathlib import Path
 
 from rlcore.errors import UserError
@@ -51,7 +52,13 @@ class Tracker:
         self.wandb_run = None
         mode = resolve_wandb_mode(wandb_mode)
         if mode != "disabled":
-            self.wandb_run = self._start_wandb(mode, run_name, config, wandb_id)
+            try:
+                self.wandb_run = self._start_wandb(mode, run_name, config, wandb_id)
+            except UserError as exc:
+                if wandb_mode != "auto":
+                    raise
+                print(f"warning: {exc}; logging offline instead", file=sys.stderr)
+                self.wandb_run = self._start_wandb("offline", run_name, config, wandb_id)
         self.wandb_id = self.wandb_run.id if self.wandb_run else None
 
     def _start_wandb(self, mode: str, run_name: str, config: dict, wandb_id: str | None):

@@ -1,0 +1,136 @@
+"""Atomic writes, checkpoints, hyperparameter parsing, tracking (wandb offline) and MP4 output."""
+import dataclasses
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+
+import imageio.v3 as iio
+import numpy as np
+import pytest
+
+from rlcore.atomic import atomic_path
+from rlcore.checkpoint import load_checkpoint, save_checkpoint
+from rlcore.configs import DQNConfig
+from rlcore.errors import UserError
+from rlcore.hparams import apply_overrides, from_dict, to_dict
+from rlcore.tracking import Tracker, resolve_wandb_mode
+from rlcore.video import record_video
+from tests import toy
+
+
+def test_failed_write_keeps_the_old_file(tmp_path):
+    target = tmp_path / "model.h5"
+    target.write_text("good")
+    with pytest.raises(RuntimeError):
+        with atomic_path(target) as tmp:
+            tmp.write_text("half")
+            raise RuntimeError("crash mid-save")
+    assert target.read_text() == "good"
+    assert list(tmp_path.iterdir()) == [target]  # no temp file left behind
+
+
+def test_kill_mid_save_keeps_the_old_checkpoint(tmp_path):
+    """A process killed while writing a large checkpoint leaves the previous one loadable."""
+    target = tmp_path / "checkpoint.npz"
+    np.savez(target, marker=np.array(1))
+    script = textwrap.dedent(f"""
+        import numpy as np, sys
+        from rlcore.atomic import atomic_path
+        with atomic_path({str(target)!r}) as tmp:
+            with open(tmp, "wb") as f:
+                f.write(b"partial")
+                f.flush()
+                print("writing", flush=True)
+                sys.stdin.read()  # hang here until killed
+    """)
+    proc = subprocess.Popen([sys.executable, "-c", script], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                            text=True, cwd=os.getcwd())
+    assert proc.stdout.readline().strip() == "writing"
+    proc.send_signal(signal.SIGKILL)
+    proc.wait(timeout=10)
+    with np.load(target) as data:
+        assert int(data["marker"]) == 1
+
+
+def test_checkpoint_round_trip_and_mismatch(tmp_path):
+    from rlcore.agents.dqn import DQNAgent
+
+    agent = DQNAgent(4, 2, DQNConfig(hidden=(8,)))
+    rng = np.random.default_rng(0)
+    batch = (rng.normal(size=(16, 4)).astype(np.float32), rng.integers(0, 2, 16).astype(np.int32),
+             rng.normal(size=16).astype(np.float32), rng.normal(size=(16, 4)).astype(np.float32),
+             np.zeros(16, np.float32))
+    agent.train_step(*batch)
+    path = save_checkpoint(tmp_path / "c.npz", agent.models(), agent.optimizers(), {"steps": 7},
+                           {"extra": np.arange(3)})
+    fresh = DQNAgent(4, 2, DQNConfig(hidden=(8,)))
+    state, arrays = load_checkpoint(path, fresh.models(), fresh.optimizers())
+    assert state == {"steps": 7} and arrays["extra"].tolist() == [0, 1, 2]
+    for a, b in zip(agent.optimizer.variables, fresh.optimizer.variables):
+        np.testing.assert_array_equal(np.asarray(a), np.asarray(b))
+    # the same next update from both: weights and Adam moments were restored
+    agent.train_step(*batch)
+    fresh.train_step(*batch)
+    for a, b in zip(agent.q_network.get_weights(), fresh.q_network.get_weights()):
+        np.testing.assert_allclose(a, b, rtol=1e-6)
+    other = DQNAgent(4, 2, DQNConfig(hidden=(16,)))
+    with pytest.raises(UserError, match="does not match this configuration"):
+        load_checkpoint(path, other.models(), other.optimizers())
+
+
+def test_hyperparameters_override_and_round_trip():
+    cfg = apply_overrides(DQNConfig(), {"lr": 1e-4, "hidden": (32, 32), "double": True})
+    assert (cfg.lr, cfg.hidden, cfg.double) == (1e-4, (32, 32), True)
+    assert from_dict(DQNConfig, to_dict(cfg)) == cfg
+    with pytest.raises(UserError, match="unknown hyperparameter"):
+        apply_overrides(cfg, {"learning_rate": 1.0})
+
+
+def test_wandb_modes(monkeypatch, tmp_path):
+    monkeypatch.delenv("WANDB_API_KEY", raising=False)
+    monkeypatch.setenv("NETRC", str(tmp_path / "no-netrc"))
+    monkeypatch.setenv("HOME", str(tmp_path))
+    assert resolve_wandb_mode("auto") == "offline"
+    assert resolve_wandb_mode("off") == "disabled"
+    monkeypatch.setenv("WANDB_API_KEY", "x" * 40)
+    assert resolve_wandb_mode("auto") == "online"
+    with pytest.raises(UserError):
+        resolve_wandb_mode("cloud")
+
+
+def test_tracker_writes_csv_and_an_offline_wandb_run(tmp_path):
+    tracker = Tracker(tmp_path, "test-run", {"lr": 1e-3}, wandb_mode="offline")
+    for episode in range(1, 4):
+        tracker.log({"episode": episode, "total_points": float(episode), "av_latest_points": 1.0,
+                     "target_ave_scores": 200.0})
+    run_id = tracker.wandb_id
+    tracker.close()
+    assert (tmp_path / "metrics.csv").read_text().splitlines()[-1] == "3,3.0,1.0,200.0"
+    run_dirs = list((tmp_path / "wandb").glob(f"offline-run-*-{run_id}"))
+    assert len(run_dirs) == 1
+    assert (run_dirs[0] / f"run-{run_id}.wandb").stat().st_size > 0
+
+
+def test_record_video_writes_a_decodable_mp4(tmp_path):
+    out = tmp_path / "toy.mp4"
+    result = record_video(toy.EXPERIMENT, lambda obs: np.ones(len(obs), np.int64), out, fps=30, episodes=2,
+                          max_episode_steps=10)
+    assert result["frames"] == 2 * 11  # reset frame + 10 steps, per episode
+    frames = iio.imread(out, plugin="pyav") if _has_pyav() else np.stack(list(iio.imiter(out)))
+    assert len(frames) == result["frames"]
+    assert frames.shape[1:] == (64, 64, 3)
+
+
+def _has_pyav():
+    try:
+        import av  # noqa: F401
+        return True
+    except ImportError:
+        return False
+
+
+def test_config_dataclasses_are_frozen():
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        DQNConfig().lr = 1.0

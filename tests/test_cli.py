@@ -1,0 +1,149 @@
+"""main.py end to end: commands, and every bad input giving one clear line and a non-zero exit."""
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import main
+from rlcore import experiment as registry
+from tests import toy
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def run(capsys, *argv):
+    try:
+        code = main.main(list(argv))
+    except SystemExit as exc:  # argparse
+        code = exc.code
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+@pytest.fixture
+def dqn_model_dir(tmp_path):
+    """An untrained LunarLander DQN model folder, written as training writes one."""
+    from rlcore.agents.dqn import DQNAgent
+    from rlcore.configs import DQNConfig
+
+    folder = tmp_path / "model"
+    DQNAgent(8, 4, DQNConfig()).save(folder)
+    (folder / "meta.json").write_text(json.dumps({"experiment": "lunar_lander", "algo": "dqn"}))
+    return folder
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["train", "moon_lander", "dqn"], "unknown experiment 'moon_lander'"),
+    (["train", "lunar_lander", "dqn3"], "unknown algorithm 'dqn3'"),
+    (["train", "lunar_lander", "dqn", "--preset", "fastest"], "unknown preset 'fastest'"),
+    (["train", "lunar_lander", "dqn", "--learning-rate", "1"], "unrecognized arguments: --learning-rate"),
+    (["train", "lunar_lander", "dqn", "--lr", "fast"], "invalid float value: 'fast'"),
+    (["evaluate", "lunar_lander", "dqn", "--model", "/nonexistent/model"], "has no meta.json"),
+    (["render", "lunar_lander", "sac"], "unknown algorithm 'sac'"),
+])
+def test_bad_input_is_one_line_and_exit_2(capsys, argv, message):
+    code, out, err = run(capsys, *argv)
+    assert code == 2
+    assert message in err
+    assert len(err.strip().splitlines()) == 1, err
+    assert "Traceback" not in err
+
+
+def test_truncated_model_file(capsys, dqn_model_dir):
+    h5 = dqn_model_dir / "q_network.h5"
+    h5.write_bytes(h5.read_bytes()[:500])
+    code, _, err = run(capsys, "evaluate", "lunar_lander", "dqn", "--model", str(dqn_model_dir))
+    assert code == 2 and "is damaged or not a Keras .h5 model" in err
+
+
+def test_model_of_another_algorithm(capsys, dqn_model_dir):
+    code, _, err = run(capsys, "render", "lunar_lander", "a2c", "--model", str(dqn_model_dir))
+    assert code == 2 and "is lunar_lander dqn, not lunar_lander a2c" in err
+
+
+def test_model_with_the_wrong_shape(capsys, dqn_model_dir):
+    from rlcore.agents.dqn import DQNAgent
+    from rlcore.configs import DQNConfig
+
+    DQNAgent(4, 2, DQNConfig()).save(dqn_model_dir)  # a CartPole-shaped net in a LunarLander folder
+    code, _, err = run(capsys, "evaluate", "lunar_lander", "dqn", "--model", str(dqn_model_dir))
+    assert code == 2 and "takes input (4,)" in err
+
+
+def test_render_failure_leaves_no_video(capsys, dqn_model_dir, tmp_path):
+    (dqn_model_dir / "q_network.h5").write_bytes(b"not hdf5")
+    out = tmp_path / "v.mp4"
+    code, _, _ = run(capsys, "render", "lunar_lander", "dqn", "--model", str(dqn_model_dir), "--out", str(out))
+    assert code == 2 and not out.exists()
+
+
+def test_resume_with_a_checkpoint_of_another_algorithm(capsys, tmp_path, monkeypatch):
+    from rlcore.trainers import dqn as dqn_trainer
+
+    monkeypatch.setitem(registry.EXPERIMENT_MODULES, "toy", "tests.toy")
+    spec = toy.spec("dqn", tmp_path, max_episodes=2, stop_score=99.0)
+    dqn_trainer.train(spec)
+    code, _, err = run(capsys, "train", "toy", "a2c", "--resume", str(spec.run_dir), "--wandb", "off")
+    assert code == 2 and "is from toy dqn, not toy a2c" in err
+
+
+def test_nan_during_training_stops_with_a_clear_error(capsys, tmp_path, monkeypatch):
+    import numpy as np
+
+    monkeypatch.setitem(registry.EXPERIMENT_MODULES, "toy", "tests.toy")
+    monkeypatch.setattr(toy.SignEnv, "step", lambda self, a: (self._obs(), np.nan, False, False, {}))
+    code, _, err = run(capsys, "train", "toy", "dqn", "--wandb", "off", "--no-progress",
+                       "--run-dir", str(tmp_path / "run"), "--episodes", "3")
+    assert code == 2 and "training diverged" in err
+
+
+def test_wandb_online_without_network_fails_fast(capsys, tmp_path, monkeypatch):
+    monkeypatch.setitem(registry.EXPERIMENT_MODULES, "toy", "tests.toy")
+    monkeypatch.setenv("WANDB_API_KEY", "a" * 40)
+    monkeypatch.setenv("WANDB_INIT_TIMEOUT", "5")
+    monkeypatch.setenv("WANDB_BASE_URL", "http://127.0.0.1:9")  # nothing listens: as with no network
+    code, _, err = run(capsys, "train", "toy", "dqn", "--wandb", "online", "--no-progress",
+                       "--run-dir", str(tmp_path / "run"), "--episodes", "2")
+    assert code == 2 and "wandb could not start in online mode" in err
+
+
+def test_list_and_help(capsys):
+    code, out, _ = run(capsys, "list")
+    assert code == 0
+    for algo in ("dqn", "ddqn", "dueling_dqn", "dueling_ddqn", "a2c"):
+        assert f"  {algo} " in out
+    code, out, _ = run(capsys, "train", "lunar_lander", "dueling_ddqn", "--help")
+    assert code == 0 and "--tau FLOAT" in out and "--updates-per-call" in out
+
+
+def test_ctrl_c_saves_a_checkpoint_and_resume_continues(tmp_path):
+    """A real SIGINT to a real training process: exit 130, checkpoint written, resume continues."""
+    import signal
+    import time
+
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    run_dir = tmp_path / "run"
+    cmd = [sys.executable, str(ROOT / "main.py"), "train", "lunar_lander", "dqn", "--wandb", "off",
+           "--no-progress", "--run-dir", str(run_dir), "--eval-episodes", "0"]
+    proc = subprocess.Popen(cmd, env=env, cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True)
+    deadline = time.time() + 120
+    while not (run_dir / "metrics.csv").exists() or len((run_dir / "metrics.csv").read_text().splitlines()) < 4:
+        assert time.time() < deadline and proc.poll() is None, proc.stderr.read() if proc.poll() else "slow"
+        time.sleep(0.2)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert "checkpoint saved to" in err and "Traceback" not in err
+    episodes_before = len((run_dir / "metrics.csv").read_text().splitlines()) - 1
+    resumed = subprocess.run(cmd[:-4] + ["--resume", str(run_dir), "--episodes", str(episodes_before + 3),
+                                         "--eval-episodes", "0"],
+                             env=env, cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert resumed.returncode == 0, resumed.stderr
+    assert f"resuming {run_dir} at episode {episodes_before}" in resumed.stdout
+    rows = (run_dir / "metrics.csv").read_text().splitlines()[1:]
+    assert [int(r.split(",")[0]) for r in rows] == list(range(1, episodes_before + 4))

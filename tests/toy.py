@@ -1,0 +1,66 @@
+"""A tiny contextual-bandit episode env and an Experiment around it, for fast learning tests.
+
+Each step shows a sign s = +-1 in the observation; action 1 pays +1 when s > 0, action 0 pays
++1 when s < 0. Ten steps per episode: a random policy scores ~5, the optimal one 10.
+"""
+import dataclasses
+
+import gymnasium as gym
+import numpy as np
+
+from rlcore.configs import A2CConfig, DQNConfig
+from rlcore.experiment import AlgoSpec, Experiment
+
+
+class SignEnv(gym.Env):
+    def __init__(self, max_episode_steps=10, render_mode=None):
+        self.observation_space = gym.spaces.Box(-1.0, 1.0, (2,), np.float32)
+        self.action_space = gym.spaces.Discrete(2)
+        self.length = max_episode_steps or 10
+        self.render_mode = render_mode
+
+    def _obs(self):
+        return np.array([self.sign, 0.5], np.float32)
+
+    def reset(self, *, seed=None, options=None):
+        super().reset(seed=seed)
+        self.t = 0
+        self.sign = self.np_random.choice([-1.0, 1.0])
+        return self._obs(), {}
+
+    def step(self, action):
+        reward = float((action == 1) == (self.sign > 0))
+        self.t += 1
+        self.sign = self.np_random.choice([-1.0, 1.0])
+        return self._obs(), reward, False, self.t >= self.length, {}
+
+    def render(self):
+        frame = np.zeros((64, 64, 3), np.uint8)
+        frame[:, : 32 if self.sign > 0 else 64] = 200
+        return frame
+
+
+def make_env(render_mode=None, max_episode_steps=10):
+    return SignEnv(max_episode_steps, render_mode)
+
+
+DQN = DQNConfig(hidden=(16,), lr=5e-3, buffer_size=2000, batch_size=32, learn_every=1, learning_starts=32,
+                tau=0.05, eps_decay=0.9, eps_end=0.02, gamma=0.5, max_episodes=80, max_episode_steps=10,
+                stop_score=9.5, window=10, checkpoint_every=20)
+A2C = A2CConfig(actor_hidden=(16,), critic_hidden=(16,), actor_lr=1e-2, critic_lr=1e-2, num_envs=4,
+                n_steps=5, gamma=0.5, reward_scale=1.0, max_episodes=400, max_episode_steps=10,
+                stop_score=9.5, window=20, checkpoint_every=40)
+
+EXPERIMENT = Experiment(
+    name="toy", description="sign bandit", make_env=make_env, solved_score=9.0,
+    algos={"dqn": AlgoSpec("dqn", "dqn", "DQN", {"default": DQN}),
+           "a2c": AlgoSpec("a2c", "a2c", "A2C", {"default": A2C})},
+    eval_seed_base=10_000)
+
+
+def spec(algo, tmp_path, **overrides):
+    from rlcore.trainers.session import RunSpec
+
+    cfg = dataclasses.replace(EXPERIMENT.preset(algo, None), **overrides)
+    return RunSpec(EXPERIMENT, algo, "default", cfg, seed=0, wandb_mode="off", run_dir=tmp_path / algo,
+                   command="pytest", progress=False)
