@@ -12,7 +12,18 @@ def _h(default, text):
 
 
 @dataclass(frozen=True)
-class DQNConfig:
+class RunBudget:
+    """When a run stops and how it keeps score; shared by every algorithm's config."""
+    max_episodes: int = _h(2000, "stop after this many finished episodes")
+    max_env_steps: int = _h(0, "stop after this many env steps, all envs together (0 = no limit)")
+    max_episode_steps: int = _h(1000, "cap on steps per episode (longer episodes are truncated)")
+    stop_score: float = _h(200.0, "stop once the mean return of the last `window` episodes reaches this")
+    window: int = _h(100, "episodes in the moving average")
+    checkpoint_every: int = _h(50, "episodes between checkpoints")
+
+
+@dataclass(frozen=True)
+class DQNConfig(RunBudget):
     """Q-learning with replay and a soft-updated target network (DQN, Double, Dueling)."""
     hidden: tuple[int, ...] = _h((64, 64), "hidden layer sizes of the Q-network (comma separated)")
     dueling: bool = _h(False, "dueling head: Q = V(s) + A(s,a) - mean_a A(s,a)")
@@ -32,16 +43,10 @@ class DQNConfig:
     eps_start: float = _h(1.0, "initial exploration rate")
     eps_end: float = _h(0.01, "final exploration rate")
     eps_decay: float = _h(0.995, "epsilon multiplied by this after every episode")
-    max_episodes: int = _h(2000, "stop after this many episodes")
-    max_env_steps: int = _h(0, "stop after this many env steps (0 = no limit)")
-    max_episode_steps: int = _h(1000, "cap on steps per episode (episodes longer are truncated)")
-    stop_score: float = _h(200.0, "stop once the mean return of the last `window` episodes reaches this")
-    window: int = _h(100, "episodes in the moving average")
-    checkpoint_every: int = _h(50, "episodes between checkpoints")
 
 
 @dataclass(frozen=True)
-class A2CConfig:
+class A2CConfig(RunBudget):
     """Advantage actor-critic: separate Actor and Critic networks, each with its own Adam.
 
     ``gae_lambda = 0`` is the article's one-step TD target r + gamma V(s'); ``gae_lambda = 1``
@@ -59,9 +64,3 @@ class A2CConfig:
     entropy_coef: float = _h(0.0, "entropy bonus weight in the actor loss")
     max_grad_norm: float = _h(0.0, "clip gradients by global norm (0 = off)")
     normalize_advantage: bool = _h(False, "standardize advantages within each update")
-    max_episodes: int = _h(5000, "stop after this many finished episodes")
-    max_env_steps: int = _h(0, "stop after this many env steps over all envs (0 = no limit)")
-    max_episode_steps: int = _h(1000, "cap on steps per episode (episodes longer are truncated)")
-    stop_score: float = _h(200.0, "stop once the mean return of the last `window` episodes reaches this")
-    window: int = _h(100, "episodes in the moving average")
-    checkpoint_every: int = _h(50, "episodes between checkpoints")
