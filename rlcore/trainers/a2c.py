@@ -1,9 +1,9 @@
-"""Rollout loop for A2C over ``num_envs`` in-process envs (Gymnasium's SyncVectorEnv)."""
+"""Rollout loop for A2C over the env pool (``num_envs`` envs, in-process or one process each)."""
 from __future__ import annotations
 
+from functools import partial
 from pathlib import Path
 
-import gymnasium as gym
 import keras
 import numpy as np
 import tensorflow as tf
@@ -12,28 +12,14 @@ from rlcore.agents.a2c import A2CAgent
 from rlcore.checkpoint import load_checkpoint, save_checkpoint
 from rlcore.errors import UserError
 from rlcore.trainers.session import RunSpec, TrainingSession, check_resumable
-
-
-def bootstrap_observations(next_obs: np.ndarray, infos: dict) -> np.ndarray:
-    """``next_obs`` with each finished env's row replaced by its final observation.
-
-    With same-step auto-reset, ``next_obs`` of a finished env is already the next episode's first
-    observation; a truncated episode must bootstrap from where it actually stopped.
-    """
-    if "_final_obs" not in infos:
-        return next_obs
-    boot = next_obs.copy()
-    for i in np.flatnonzero(infos["_final_obs"]):
-        boot[i] = infos["final_obs"][i]
-    return boot
+from rlcore.vector import EnvPool, bootstrap_observations
 
 
 def train(spec: RunSpec) -> Path:
     cfg = spec.config
     keras.utils.set_random_seed(spec.seed)
-    envs = gym.vector.SyncVectorEnv(
-        [lambda: spec.experiment.make_env(max_episode_steps=cfg.max_episode_steps)] * cfg.num_envs,
-        autoreset_mode=gym.vector.AutoresetMode.SAME_STEP)
+    envs = EnvPool([partial(spec.experiment.make_env, max_episode_steps=cfg.max_episode_steps)] * cfg.num_envs,
+                   mode=cfg.vec)
     obs_dim, n_actions = envs.single_observation_space.shape[0], int(envs.single_action_space.n)
     agent = A2CAgent(obs_dim, n_actions, cfg)
     rng = np.random.default_rng(spec.seed)
@@ -59,7 +45,7 @@ def train(spec: RunSpec) -> Path:
     # a resumed run starts fresh episodes, reseeded from its episode count
     obs, _ = envs.reset(seed=[spec.seed * 1000 + session.book.episodes + i for i in range(n)])
     next_checkpoint = (session.book.episodes // cfg.checkpoint_every + 1) * cfg.checkpoint_every
-    with session.interruptible():
+    with envs, session.interruptible():
         while not session.should_stop():
             for step in range(t):
                 actions = agent.act(obs, rng)
@@ -84,7 +70,6 @@ def train(spec: RunSpec) -> Path:
             if session.book.episodes >= next_checkpoint:
                 checkpoint()
                 next_checkpoint += cfg.checkpoint_every
-    envs.close()
     checkpoint()
     if session.stop_requested:
         raise session.interrupted()

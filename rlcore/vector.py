@@ -1,0 +1,122 @@
+"""The env pool: N environments stepped together, in-process or one process each over Pipes.
+
+Both modes are Gymnasium's own vector envs (SyncVectorEnv, AsyncVectorEnv) with same-step
+auto-reset: when an episode ends, ``infos["final_obs"]`` holds its last observation (for the
+bootstrap of a truncated episode) and the returned observation already starts the next one.
+
+Processes start with ``forkserver`` (``spawn`` where that is missing): forking a process that has
+loaded TensorFlow can deadlock. Env factories must be picklable and live in TensorFlow-free
+modules, so workers start without importing TensorFlow.
+
+A worker that dies or stops answering raises :class:`EnvWorkerDied` naming the worker, and the
+pool closes the rest: no hang, no process left behind.
+"""
+from __future__ import annotations
+
+import multiprocessing
+from typing import Callable, Sequence
+
+import gymnasium as gym
+import numpy as np
+
+from rlcore.errors import UserError
+
+VEC_MODES = ("inline", "processes")
+
+
+class EnvWorkerDied(UserError):
+    """An env worker process exited or stopped answering."""
+
+
+def _start_method() -> str:
+    return "forkserver" if "forkserver" in multiprocessing.get_all_start_methods() else "spawn"
+
+
+def bootstrap_observations(next_obs: np.ndarray, infos: dict) -> np.ndarray:
+    """``next_obs`` with each finished env's row replaced by its final observation.
+
+    With same-step auto-reset, ``next_obs`` of a finished env is already the next episode's first
+    observation; a truncated episode must bootstrap from where it actually stopped.
+    """
+    if "_final_obs" not in infos:
+        return next_obs
+    boot = next_obs.copy()
+    for i in np.flatnonzero(infos["_final_obs"]):
+        boot[i] = infos["final_obs"][i]
+    return boot
+
+
+class EnvPool:
+    """``num_envs`` copies of an env behind one batched ``reset`` / ``step`` / ``close``."""
+
+    def __init__(self, env_fns: Sequence[Callable[[], gym.Env]], mode: str = "inline",
+                 step_timeout: float = 60.0):
+        if mode not in VEC_MODES:
+            raise UserError(f"unknown vector mode {mode!r}; choose one of {', '.join(VEC_MODES)}")
+        self.mode, self.step_timeout = mode, step_timeout
+        autoreset = gym.vector.AutoresetMode.SAME_STEP
+        if mode == "processes":
+            self.envs = gym.vector.AsyncVectorEnv(env_fns, context=_start_method(), daemon=True,
+                                                  autoreset_mode=autoreset)
+        else:
+            self.envs = gym.vector.SyncVectorEnv(env_fns, autoreset_mode=autoreset)
+        self.num_envs = self.envs.num_envs
+        self.single_observation_space = self.envs.single_observation_space
+        self.single_action_space = self.envs.single_action_space
+        self.closed = False
+
+    def reset(self, seed: int | list[int] | None = None):
+        return self._guard(lambda: self.envs.reset(seed=seed))
+
+    def step(self, actions: np.ndarray):
+        """(obs, rewards, terminated, truncated, infos) for all envs."""
+        if self.mode == "inline":
+            return self.envs.step(actions)
+
+        def step():
+            self.envs.step_async(actions)
+            return self.envs.step_wait(timeout=self.step_timeout)
+        return self._guard(step)
+
+    def _guard(self, call):
+        try:
+            return call()
+        except (EOFError, ConnectionResetError, BrokenPipeError, multiprocessing.TimeoutError) as exc:
+            message = self._describe_failure(exc)
+            self.close(terminate=True)
+            raise EnvWorkerDied(message) from None
+
+    def _describe_failure(self, exc: BaseException) -> str:
+        processes = getattr(self.envs, "processes", [])
+        dead = [(i, p) for i, p in enumerate(processes) if not p.is_alive()]
+        if not dead:
+            return (f"env workers stopped answering ({type(exc).__name__}); "
+                    f"no reply within {self.step_timeout:g} s")
+        parts = []
+        for i, p in dead:
+            how = (f"killed by signal {-p.exitcode}" if p.exitcode is not None and p.exitcode < 0
+                   else f"exited with code {p.exitcode}")
+            parts.append(f"env worker {i} (pid {p.pid}) {how}")
+        return "; ".join(parts) + ": the env pool is closed; restart the run (or --resume it)"
+
+    def worker_pids(self) -> list[int]:
+        return [p.pid for p in getattr(self.envs, "processes", [])]
+
+    def close(self, terminate: bool = False) -> None:
+        """Close every env; with processes, join every worker (terminating any that hang)."""
+        if self.closed:
+            return
+        self.closed = True
+        if self.mode == "processes":
+            try:
+                self.envs.close(terminate=terminate, timeout=None if terminate else 10)
+            except Exception:
+                self.envs.close(terminate=True)
+        else:
+            self.envs.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close(terminate=exc[0] is not None)
