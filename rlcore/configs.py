@@ -20,6 +20,10 @@ class RunBudget:
     stop_score: float = _h(200.0, "stop once the mean return of the last `window` episodes reaches this")
     window: int = _h(100, "episodes in the moving average")
     checkpoint_every: int = _h(50, "episodes between checkpoints")
+    eval_every_steps: int = _h(0, "greedy evaluation every this many env steps, on fixed selection "
+                                  "seeds (0 = off); written to evals.csv")
+    eval_episodes: int = _h(10, "episodes per periodic evaluation")
+    keep_best: bool = _h(False, "save the weights of the best periodic evaluation, not the last ones")
 
 
 @dataclass(frozen=True)

@@ -34,7 +34,8 @@ class Experiment:
     make_env: Callable  # make_env(render_mode=None, max_episode_steps=None) -> gymnasium.Env
     algos: dict[str, AlgoSpec]
     solved_score: float
-    eval_seed_base: int = 1_000_000  # evaluation seeds start here; training never uses them
+    eval_seed_base: int = 1_000_000  # final evaluation seeds start here; training never uses them
+    selection_seed_base: int = 2_000_000  # periodic evaluations during training (model selection)
     video_fps: int = 30
     extra: dict = field(default_factory=dict)
 

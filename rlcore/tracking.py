@@ -47,8 +47,7 @@ class Tracker:
         self.run_dir = Path(run_dir)
         self.run_dir.mkdir(parents=True, exist_ok=True)
         self.csv_path = self.run_dir / "metrics.csv"
-        self._csv_file = None
-        self._writer = None
+        self._tables: dict[str, tuple] = {}  # table name -> (file, csv.DictWriter)
         self.wandb_run = None
         mode = resolve_wandb_mode(wandb_mode)
         if mode != "disabled":
@@ -77,28 +76,35 @@ class Tracker:
             raise UserError(f"wandb could not start in {mode} mode ({reason}); "
                             "use --wandb offline (sync later with `wandb sync`) or --wandb off")
 
-    def log(self, row: dict) -> None:
-        if self._writer is None:
-            exists = self.csv_path.exists() and self.csv_path.stat().st_size > 0
+    def table_path(self, table: str) -> Path:
+        return self.run_dir / f"{table}.csv"
+
+    def log(self, row: dict, table: str = "metrics") -> None:
+        """Append ``row`` to ``<run_dir>/<table>.csv`` and send its numbers to wandb."""
+        if table not in self._tables:
+            path = self.table_path(table)
+            exists = path.exists() and path.stat().st_size > 0
             if exists:
-                with open(self.csv_path, newline="") as f:
+                with open(path, newline="") as f:
                     fieldnames = next(csv.reader(f))
             else:
                 fieldnames = list(row)
-            self._csv_file = open(self.csv_path, "a", newline="")
-            self._writer = csv.DictWriter(self._csv_file, fieldnames=fieldnames, extrasaction="ignore")
+            handle = open(path, "a", newline="")
+            writer = csv.DictWriter(handle, fieldnames=fieldnames, extrasaction="ignore")
             if not exists:
-                self._writer.writeheader()
-        self._writer.writerow(row)
-        self._csv_file.flush()
+                writer.writeheader()
+            self._tables[table] = (handle, writer)
+        handle, writer = self._tables[table]
+        writer.writerow(row)
+        handle.flush()
         if self.wandb_run is not None:
             self.wandb_run.log({k: v for k, v in row.items()
                                 if isinstance(v, (int, float)) and not math.isnan(v)})
 
     def close(self) -> None:
-        if self._csv_file is not None:
-            self._csv_file.close()
-            self._csv_file, self._writer = None, None
+        for handle, _ in self._tables.values():
+            handle.close()
+        self._tables.clear()
         if self.wandb_run is not None:
             self.wandb_run.finish()
             self.wandb_run = None

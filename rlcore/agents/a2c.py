@@ -135,6 +135,10 @@ class A2CAgent:
         draws = rng.random((len(cdf), 1)) * cdf[:, -1:]
         return np.minimum((draws > cdf).sum(axis=1), self.n_actions - 1).astype(np.int32)
 
+    def greedy_actions(self, obs: np.ndarray) -> np.ndarray:
+        """argmax_a pi(a|s) for a batch of observations."""
+        return self.probs(obs).argmax(axis=1)
+
     # --------------------------------------------------------------- learning
     def _update_graph(self, obs, actions, rewards, next_obs, terminated, dones):
         cfg = self.cfg
@@ -170,6 +174,16 @@ class A2CAgent:
 
     def models(self) -> dict[str, keras.Model]:
         return {"actor": self.actor.model, "critic": self.critic.model}
+
+    def get_weights(self) -> list[np.ndarray]:
+        """Actor then critic weights (a snapshot for keep_best)."""
+        return self.actor.model.get_weights() + self.critic.model.get_weights()
+
+    def set_weights(self, weights: list[np.ndarray]) -> None:
+        n_actor = len(self.actor.model.get_weights())
+        self.actor.model.set_weights(weights[:n_actor])
+        self.critic.model.set_weights(weights[n_actor:])
+        self.sync_policy_weights()
 
     def optimizers(self) -> dict:
         return {"actor_opt": self.actor.opt, "critic_opt": self.critic.opt}

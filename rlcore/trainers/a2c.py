@@ -26,14 +26,16 @@ def train(spec: RunSpec) -> Path:
 
     state = check_resumable(spec) if spec.resume else None
     if state is not None:
-        state, _ = load_checkpoint(spec.run_dir / "checkpoint.npz", agent.models(), agent.optimizers())
+        state, arrays = load_checkpoint(spec.run_dir / "checkpoint.npz", agent.models(), agent.optimizers())
         rng.bit_generator.state = state["rng"]
         agent.sync_policy_weights()
     session = TrainingSession(spec, state)
+    if state is not None:
+        session.restore_best_arrays(arrays)
 
     def checkpoint():
         save_checkpoint(session.checkpoint_path, agent.models(), agent.optimizers(),
-                        session.state(rng=rng.bit_generator.state))
+                        session.state(rng=rng.bit_generator.state), session.best_arrays())
 
     t, n = cfg.n_steps, cfg.num_envs
     buf_obs = np.zeros((t, n, obs_dim), np.float32)
@@ -67,10 +69,11 @@ def train(spec: RunSpec) -> Path:
                     raise
                 raise UserError(f"training diverged: NaN/Inf in the A2C loss at env step {session.env_steps}; "
                                 "lower the learning rates or resume from the last checkpoint") from None
+            session.maybe_evaluate(agent.greedy_actions, agent.get_weights)
             if session.book.episodes >= next_checkpoint:
                 checkpoint()
                 next_checkpoint += cfg.checkpoint_every
     checkpoint()
     if session.stop_requested:
         raise session.interrupted()
-    return session.finish(agent.save)
+    return session.finish(agent.save, agent.set_weights)

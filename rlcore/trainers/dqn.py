@@ -33,12 +33,14 @@ def train(spec: RunSpec) -> Path:
         epsilon = state["epsilon"]
         agent.sync_policy_weights()
     session = TrainingSession(spec, state)
+    if state is not None:
+        session.restore_best_arrays(arrays)
     grad_steps = int(state["grad_steps"]) if state else 0
 
     def checkpoint():
         save_checkpoint(session.checkpoint_path, agent.models(), agent.optimizers(),
                         session.state(epsilon=epsilon, grad_steps=grad_steps, rng=rng.bit_generator.state),
-                        {f"replay/{k}": v for k, v in memory.state_dict().items()})
+                        {**{f"replay/{k}": v for k, v in memory.state_dict().items()}, **session.best_arrays()})
 
     update_period = cfg.learn_every * cfg.updates_per_call
     first_seed = spec.seed + session.book.episodes  # a resumed run reseeds from its episode count
@@ -60,6 +62,7 @@ def train(spec: RunSpec) -> Path:
                     stacked = [x.reshape(cfg.updates_per_call, cfg.batch_size, *x.shape[1:]) for x in batch]
                     losses.append(_train_steps(agent, stacked, session.env_steps))
                     grad_steps += cfg.updates_per_call
+                session.maybe_evaluate(agent.greedy_actions, agent.q_network.get_weights)
                 if terminated or truncated or session.stop_requested:
                     break
             if session.stop_requested:  # partial episode: not counted; its transitions stay in replay
@@ -75,7 +78,7 @@ def train(spec: RunSpec) -> Path:
         checkpoint()
         raise session.interrupted()
     checkpoint()
-    return session.finish(lambda folder: [agent.save(folder)])
+    return session.finish(lambda folder: [agent.save(folder)], agent.q_network.set_weights)
 
 
 def _train_steps(agent: DQNAgent, batch, env_steps: int) -> dict:

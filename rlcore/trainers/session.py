@@ -132,6 +132,9 @@ class TrainingSession:
         self._started = time.perf_counter()
         self._steps_at_start = self.env_steps
         self.stop_requested = False
+        self.best_eval = state.get("best_eval")  # {"mean", "std", "env_steps"} of the best evaluation
+        self.best_weights = None  # snapshot of the best evaluation's weights (keep_best)
+        self.next_eval_step = int(state.get("next_eval_step", cfg.eval_every_steps))
         self.tracker = Tracker(self.run_dir, self.run_dir.name, self.describe(), spec.wandb_mode,
                                wandb_id=state.get("wandb_id"))
         self.progress = tqdm(total=cfg.max_episodes, initial=self.book.episodes, unit="ep",
@@ -156,6 +159,29 @@ class TrainingSession:
         self.progress.set_postfix(avg100=f"{self.book.average:.1f}", steps=self.env_steps,
                                   sps=f"{rate:.0f}", refresh=False)
 
+    def maybe_evaluate(self, greedy_policy, snapshot) -> None:
+        """Every ``eval_every_steps`` env steps: greedy episodes on the fixed selection seeds.
+
+        ``greedy_policy(obs_batch) -> actions``; ``snapshot() -> weights`` is kept for the best
+        evaluation when ``keep_best`` is set.
+        """
+        cfg, exp = self.spec.config, self.spec.experiment
+        if not cfg.eval_every_steps or self.env_steps < self.next_eval_step:
+            return
+        while self.next_eval_step <= self.env_steps:
+            self.next_eval_step += cfg.eval_every_steps
+        from rlcore.evaluation import evaluate
+
+        returns = evaluate(exp, greedy_policy, cfg.eval_episodes, seed_base=exp.selection_seed_base,
+                           max_episode_steps=cfg.max_episode_steps, progress=False)
+        mean, std = float(returns.mean()), float(returns.std())
+        self.tracker.log({"env_steps": self.env_steps, "episode": self.book.episodes,
+                          "eval_mean": mean, "eval_std": std}, table="evals")
+        if self.best_eval is None or mean >= self.best_eval["mean"]:
+            self.best_eval = {"mean": round(mean, 2), "std": round(std, 2), "env_steps": self.env_steps}
+            if cfg.keep_best:
+                self.best_weights = snapshot()
+
     def should_stop(self) -> bool:
         cfg = self.spec.config
         if self.stop_requested:
@@ -170,7 +196,18 @@ class TrainingSession:
         """JSON-able counters for a checkpoint."""
         return {**self.describe(), "returns": self.book.returns, "solved_episode": self.book.solved_episode,
                 "env_steps": self.env_steps, "wall_seconds": self.elapsed(),
-                "wandb_id": self.tracker.wandb_id, **extra}
+                "wandb_id": self.tracker.wandb_id, "best_eval": self.best_eval,
+                "next_eval_step": self.next_eval_step, **extra}
+
+    def best_arrays(self) -> dict:
+        """The kept best weights, as checkpoint arrays."""
+        if self.best_weights is None:
+            return {}
+        return {f"best/{i}": w for i, w in enumerate(self.best_weights)}
+
+    def restore_best_arrays(self, arrays: dict) -> None:
+        keys = sorted((k for k in arrays if k.startswith("best/")), key=lambda k: int(k.split("/")[1]))
+        self.best_weights = [arrays[k] for k in keys] or None
 
     @property
     def checkpoint_path(self) -> Path:
@@ -193,10 +230,16 @@ class TrainingSession:
             signal.signal(signal.SIGINT, previous)
 
     # ------------------------------------------------------------- finishing
-    def finish(self, save_models) -> Path:
-        """Write the model folder: ``save_models(folder)`` writes the ``.h5`` files, then meta + plot."""
+    def finish(self, save_models, load_weights=None) -> Path:
+        """Write the model folder: ``save_models(folder)`` writes the ``.h5`` files, then meta + plot.
+
+        With ``keep_best``, ``load_weights(best_weights)`` first puts the best evaluation's weights back.
+        """
         self.progress.close()
         self.tracker.close()
+        kept_best = self.spec.config.keep_best and self.best_weights is not None
+        if kept_best:
+            load_weights(self.best_weights)
         model_dir = self.run_dir / "model"
         model_dir.mkdir(parents=True, exist_ok=True)
         files = [p.name for p in save_models(model_dir)]
@@ -204,11 +247,15 @@ class TrainingSession:
         plot_name = f"{exp.extra.get('plot_prefix', exp.name)}_Train_{s.algo}.png"
         plot_episode_scores(self.tracker.csv_path, model_dir / plot_name,
                             f"{exp.name} {s.algo} ({s.preset} preset, seed {s.seed})", exp.solved_score)
-        (model_dir / "metrics.csv").write_bytes(self.tracker.csv_path.read_bytes())
+        for table in ("metrics", "evals"):
+            if self.tracker.table_path(table).exists():
+                (model_dir / f"{table}.csv").write_bytes(self.tracker.table_path(table).read_bytes())
         meta = {**self.describe(), "command": s.command, "env_steps": self.env_steps,
                 "episodes": self.book.episodes, "wall_seconds": round(self.elapsed(), 1),
                 "solved_episode": self.book.solved_episode,
                 "final_average": round(self.book.average, 2), "model_files": files,
+                "weights": "best periodic evaluation" if kept_best else "last",
+                "best_eval": self.best_eval,
                 "plot": plot_name, "versions": package_versions(),
                 "finished": datetime.now(timezone.utc).isoformat(timespec="seconds")}
         write_json(model_dir / "meta.json", meta)

@@ -81,3 +81,20 @@ def test_evaluation_uses_the_requested_seeds():
     assert len(a) == 7
     assert sorted(a) == sorted(b)
     assert sorted(a) != sorted(c)
+
+
+@pytest.mark.parametrize("algo", ["dqn", "a2c"])
+def test_periodic_evaluation_keeps_the_best_weights(algo, tmp_path):
+    spec = toy.spec(algo, tmp_path, eval_every_steps=100, eval_episodes=4, keep_best=True, stop_score=99.0,
+                    max_episodes=40)
+    model_dir = TRAINERS[algo].train(spec)
+    meta = json.loads((model_dir / "meta.json").read_text())
+    evals = (model_dir / "evals.csv").read_text().splitlines()
+    assert evals[0] == "env_steps,episode,eval_mean,eval_std"
+    assert len(evals) - 1 == meta["env_steps"] // 100
+    best = max(float(line.split(",")[2]) for line in evals[1:])
+    assert meta["weights"] == "best periodic evaluation" and meta["best_eval"]["mean"] == pytest.approx(best)
+    # the saved model is the best one: it scores the best evaluation again on the same seeds
+    exp, _, policy = load_policy(model_dir)
+    again = evaluate(exp, policy, 4, seed_base=exp.selection_seed_base, max_episode_steps=10, progress=False)
+    assert again.mean() == pytest.approx(best)
