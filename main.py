@@ -89,8 +89,8 @@ def cmd_train(args) -> int:
     meta = json.loads((model_dir / "meta.json").read_text())
     print(f"trained: {meta['episodes']} episodes, {meta['env_steps']} env steps, "
           f"{meta['wall_seconds']:.0f} s; last-100 average {meta['final_average']:.1f}")
-    if args.eval_episodes > 0:
-        meta = _evaluate_into_meta(model_dir, args.eval_episodes)
+    if args.final_eval_episodes > 0:
+        meta = _evaluate_into_meta(model_dir, args.final_eval_episodes)
     print(f"model:   {model_dir}/")
     print(f"plot:    {model_dir / meta['plot']}")
     print(f"metrics: {model_dir / 'metrics.csv'}")
@@ -200,7 +200,7 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
     train.add_argument("--resume", nargs="?", const="latest", default=None, metavar="RUN_DIR",
                        help="continue a run from its checkpoint (default: the latest run of this algo)")
     train.add_argument("--run-dir", default=None, help="where the run writes (default runs/<name>)")
-    train.add_argument("--eval-episodes", type=int, default=100,
+    train.add_argument("--final-eval-episodes", type=int, default=100,
                        help="greedy evaluation episodes after training, on unseen seeds (default 100)")
     train.add_argument("--video", action="store_true", help="also render an MP4 of the trained agent")
     train.add_argument("--publish", action="store_true",

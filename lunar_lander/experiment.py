@@ -39,13 +39,15 @@ def _dqn_presets(**switches) -> dict:
 _A2C_ARTICLE = A2CConfig()
 _A2C_DEFAULT = dataclasses.replace(
     _A2C_ARTICLE, num_envs=8, n_steps=16, gae_lambda=0.95, gamma=0.99, actor_lr=7e-4, critic_lr=1e-3,
-    entropy_coef=0.01, max_grad_norm=0.5, normalize_advantage=True, stop_score=230.0, max_episodes=20000)
+    entropy_coef=0.01, max_grad_norm=0.5, normalize_advantage=True, stop_score=230.0, max_episodes=20000,
+    max_env_steps=4_000_000, eval_every_steps=50_000, eval_episodes=20, keep_best=True)
 
 EXPERIMENT = Experiment(
     name="lunar_lander",
     description="LunarLander-v3 (8-d state, 4 actions; solved = 100-episode mean >= 200), article 000",
     make_env=make_env,
     solved_score=SOLVED_SCORE,
+    extra={"plot_prefix": "LunarLander"},
     algos={
         "dqn": AlgoSpec("dqn", "dqn", "DQN", _dqn_presets()),
         "ddqn": AlgoSpec("ddqn", "dqn", "Double DQN", _dqn_presets(double=True)),

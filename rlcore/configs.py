@@ -16,7 +16,8 @@ class RunBudget:
     """When a run stops and how it keeps score; shared by every algorithm's config."""
     max_episodes: int = _h(2000, "stop after this many finished episodes")
     max_env_steps: int = _h(0, "stop after this many env steps, all envs together (0 = no limit)")
-    max_episode_steps: int = _h(1000, "cap on steps per episode (longer episodes are truncated)")
+    max_episode_steps: int = _h(1000, "cap on steps per episode, longer ones are truncated "
+                                      "(0 = the env's registered limit)")
     stop_score: float = _h(200.0, "stop once the mean return of the last `window` episodes reaches this")
     window: int = _h(100, "episodes in the moving average")
     checkpoint_every: int = _h(50, "episodes between checkpoints")
@@ -46,7 +47,10 @@ class DQNConfig(RunBudget):
     tau: float = _h(1e-3, "soft target update rate, applied after every gradient step")
     eps_start: float = _h(1.0, "initial exploration rate")
     eps_end: float = _h(0.01, "final exploration rate")
-    eps_decay: float = _h(0.995, "epsilon multiplied by this after every episode")
+    eps_schedule: str = _h("episode", "episode: eps *= eps_decay after each episode | "
+                                      "steps: eps = end + (start - end) exp(-steps / eps_decay_steps)")
+    eps_decay: float = _h(0.995, "epsilon multiplied by this after every episode (eps_schedule episode)")
+    eps_decay_steps: float = _h(1000.0, "time constant in env steps (eps_schedule steps)")
 
 
 @dataclass(frozen=True)

@@ -6,8 +6,10 @@ from tqdm import tqdm
 
 
 def evaluate(experiment, policy, episodes: int = 100, seed_base: int | None = None,
-             max_episode_steps: int | None = 1000, progress: bool = True) -> np.ndarray:
+             max_episode_steps: int | None = None, progress: bool = True) -> np.ndarray:
     """Play ``episodes`` greedy episodes, episode i seeded ``seed_base + i``; return the returns.
+
+    ``max_episode_steps=None`` keeps the env's registered time limit.
 
     All episodes run side by side in an in-process vector env so the policy sees one batch per step.
     """

@@ -14,6 +14,8 @@ from rlcore.errors import UserError
 #: experiment name -> module holding ``EXPERIMENT``
 EXPERIMENT_MODULES = {
     "lunar_lander": "lunar_lander.experiment",
+    "cartpole": "cartpole.experiment",
+    "cartpole_v0": "cartpole.experiment_v0",
 }
 
 

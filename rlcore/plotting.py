@@ -13,7 +13,7 @@ from rlcore.atomic import atomic_path  # noqa: E402
 
 
 def plot_episode_scores(csv_path: str | Path, png_path: str | Path, title: str,
-                        solved_score: float | None = None) -> Path:
+                        solved_score: float | None = None, score_label: str = "return") -> Path:
     """Score per episode, its moving average and the solved line, as in article 000's figure."""
     df = pd.read_csv(csv_path)
     fig, ax = plt.subplots(figsize=(9, 5))
@@ -23,7 +23,26 @@ def plot_episode_scores(csv_path: str | Path, png_path: str | Path, title: str,
     if solved_score is not None:
         ax.axhline(solved_score, color="tab:red", linewidth=2, linestyle="--", label="Solved requirement")
     ax.set_xlabel("episode")
-    ax.set_ylabel("return")
+    ax.set_ylabel(score_label)
+    return _save(fig, ax, title, png_path)
+
+
+def plot_evaluations(csv_path: str | Path, png_path: str | Path, title: str,
+                     solved_score: float | None = None, score_label: str = "return") -> Path:
+    """Periodic greedy evaluation: mean +- std against env steps (article 002's test-reward curve)."""
+    df = pd.read_csv(csv_path)
+    fig, ax = plt.subplots(figsize=(9, 5))
+    ax.plot(df["env_steps"], df["eval_mean"], color="tab:blue", linewidth=2, label="Evaluation mean")
+    ax.fill_between(df["env_steps"], df["eval_mean"] - df["eval_std"], df["eval_mean"] + df["eval_std"],
+                    color="tab:blue", alpha=0.2, label="+- std")
+    if solved_score is not None:
+        ax.axhline(solved_score, color="tab:red", linewidth=2, linestyle="--", label="Solved requirement")
+    ax.set_xlabel("env steps")
+    ax.set_ylabel(f"greedy {score_label}")
+    return _save(fig, ax, title, png_path)
+
+
+def _save(fig, ax, title, png_path) -> Path:
     ax.set_title(title)
     ax.grid(alpha=0.3)
     ax.legend(loc="lower right")

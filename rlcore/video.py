@@ -10,7 +10,7 @@ from rlcore.atomic import atomic_path
 
 
 def record_video(experiment, policy, path: str | Path, fps: int = 30, episodes: int = 1,
-                 seed: int | None = None, max_episode_steps: int | None = 1000) -> dict:
+                 seed: int | None = None, max_episode_steps: int | None = None) -> dict:
     """Write ``episodes`` greedy episodes to ``path``; return frame count and episode returns."""
     seed = experiment.eval_seed_base if seed is None else seed
     env = experiment.make_env(render_mode="rgb_array", max_episode_steps=max_episode_steps)

@@ -128,7 +128,7 @@ def test_ctrl_c_saves_a_checkpoint_and_resume_continues(tmp_path):
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     run_dir = tmp_path / "run"
     cmd = [sys.executable, str(ROOT / "main.py"), "train", "lunar_lander", "dqn", "--wandb", "off",
-           "--no-progress", "--run-dir", str(run_dir), "--eval-episodes", "0"]
+           "--no-progress", "--run-dir", str(run_dir), "--final-eval-episodes", "0"]
     proc = subprocess.Popen(cmd, env=env, cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True)
     deadline = time.time() + 120
@@ -141,9 +141,21 @@ def test_ctrl_c_saves_a_checkpoint_and_resume_continues(tmp_path):
     assert "checkpoint saved to" in err and "Traceback" not in err
     episodes_before = len((run_dir / "metrics.csv").read_text().splitlines()) - 1
     resumed = subprocess.run(cmd[:-4] + ["--resume", str(run_dir), "--episodes", str(episodes_before + 3),
-                                         "--eval-episodes", "0"],
+                                         "--final-eval-episodes", "0"],
                              env=env, cwd=tmp_path, capture_output=True, text=True, timeout=300)
     assert resumed.returncode == 0, resumed.stderr
     assert f"resuming {run_dir} at episode {episodes_before}" in resumed.stdout
     rows = (run_dir / "metrics.csv").read_text().splitlines()[1:]
     assert [int(r.split(",")[0]) for r in rows] == list(range(1, episodes_before + 4))
+
+
+def test_every_algorithm_builds_its_train_parser(capsys):
+    """Hyperparameter flags must not collide with the CLI's own flags, for any preset."""
+    from rlcore.experiment import experiment_names, get_experiment
+
+    for name in experiment_names():
+        for algo, spec in get_experiment(name).algos.items():
+            for preset in spec.presets:
+                parser = main.build_parser(["train", name, algo, "--preset", preset])
+                args = parser.parse_args(["train", name, algo, "--preset", preset])
+                assert args.algo == algo

@@ -18,8 +18,8 @@ from rlcore.vector import EnvPool, bootstrap_observations
 def train(spec: RunSpec) -> Path:
     cfg = spec.config
     keras.utils.set_random_seed(spec.seed)
-    envs = EnvPool([partial(spec.experiment.make_env, max_episode_steps=cfg.max_episode_steps)] * cfg.num_envs,
-                   mode=cfg.vec)
+    make_env = partial(spec.experiment.make_env, max_episode_steps=cfg.max_episode_steps or None)
+    envs = EnvPool([make_env] * cfg.num_envs, mode=cfg.vec)
     obs_dim, n_actions = envs.single_observation_space.shape[0], int(envs.single_action_space.n)
     agent = A2CAgent(obs_dim, n_actions, cfg)
     rng = np.random.default_rng(spec.seed)

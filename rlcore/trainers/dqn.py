@@ -1,6 +1,7 @@
 """Episode loop for the Q-learning agents (DQN, Double, Dueling, Dueling Double)."""
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import keras
@@ -17,8 +18,10 @@ from rlcore.trainers.session import RunSpec, TrainingSession, check_resumable
 def train(spec: RunSpec) -> Path:
     """Train until the stop score, episode or step budget; return the model folder."""
     cfg = spec.config
+    if cfg.eps_schedule not in ("episode", "steps"):
+        raise UserError(f"unknown eps_schedule {cfg.eps_schedule!r} (episode | steps)")
     keras.utils.set_random_seed(spec.seed)
-    env = spec.experiment.make_env(max_episode_steps=cfg.max_episode_steps)
+    env = spec.experiment.make_env(max_episode_steps=cfg.max_episode_steps or None)
     obs_dim, n_actions = env.observation_space.shape[0], int(env.action_space.n)
     agent = DQNAgent(obs_dim, n_actions, cfg)
     memory = ReplayMemory(cfg.buffer_size, (obs_dim,))
@@ -50,6 +53,9 @@ def train(spec: RunSpec) -> Path:
             first_seed = None  # later episodes continue the env's own RNG
             episode_return, losses = 0.0, []
             while True:
+                if cfg.eps_schedule == "steps":  # the PyTorch tutorial: exponential in actions taken
+                    epsilon = cfg.eps_end + (cfg.eps_start - cfg.eps_end) * math.exp(
+                        -session.env_steps / cfg.eps_decay_steps)
                 action = agent.act(obs, epsilon, rng)
                 next_obs, reward, terminated, truncated, _ = env.step(action)
                 memory.add(obs, action, reward, next_obs, terminated)
@@ -67,7 +73,8 @@ def train(spec: RunSpec) -> Path:
                     break
             if session.stop_requested:  # partial episode: not counted; its transitions stay in replay
                 break
-            epsilon = max(cfg.eps_end, epsilon * cfg.eps_decay)
+            if cfg.eps_schedule == "episode":
+                epsilon = max(cfg.eps_end, epsilon * cfg.eps_decay)
             mean_losses = {k: float(np.mean([l[k] for l in losses])) if losses else float("nan")
                            for k in ("loss", "q_mean")}
             session.end_episode(episode_return, {"epsilon": epsilon, "grad_steps": grad_steps, **mean_losses})

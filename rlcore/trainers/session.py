@@ -20,7 +20,7 @@ from rlcore.atomic import write_json
 from rlcore.checkpoint import read_checkpoint_state
 from rlcore.errors import UserError
 from rlcore.hparams import to_dict
-from rlcore.plotting import plot_episode_scores
+from rlcore.plotting import plot_episode_scores, plot_evaluations
 from rlcore.tracking import Tracker
 
 RUNS_DIR = Path("runs")
@@ -173,7 +173,7 @@ class TrainingSession:
         from rlcore.evaluation import evaluate
 
         returns = evaluate(exp, greedy_policy, cfg.eval_episodes, seed_base=exp.selection_seed_base,
-                           max_episode_steps=cfg.max_episode_steps, progress=False)
+                           max_episode_steps=cfg.max_episode_steps or None, progress=False)
         mean, std = float(returns.mean()), float(returns.std())
         self.tracker.log({"env_steps": self.env_steps, "episode": self.book.episodes,
                           "eval_mean": mean, "eval_std": std}, table="evals")
@@ -245,8 +245,12 @@ class TrainingSession:
         files = [p.name for p in save_models(model_dir)]
         exp, s = self.spec.experiment, self.spec
         plot_name = f"{exp.extra.get('plot_prefix', exp.name)}_Train_{s.algo}.png"
-        plot_episode_scores(self.tracker.csv_path, model_dir / plot_name,
-                            f"{exp.name} {s.algo} ({s.preset} preset, seed {s.seed})", exp.solved_score)
+        title = f"{exp.name} {s.algo} ({s.preset} preset, seed {s.seed})"
+        label = exp.extra.get("score_label", "return")
+        plot_episode_scores(self.tracker.csv_path, model_dir / plot_name, title, exp.solved_score, label)
+        if self.tracker.table_path("evals").exists():
+            plot_evaluations(self.tracker.table_path("evals"), model_dir / f"{exp.name}_Eval_{s.algo}.png",
+                             title, exp.solved_score, label)
         for table in ("metrics", "evals"):
             if self.tracker.table_path(table).exists():
                 (model_dir / f"{table}.csv").write_bytes(self.tracker.table_path(table).read_bytes())
