@@ -81,10 +81,9 @@ def train(spec: RunSpec) -> Path:
             if session.book.episodes % cfg.checkpoint_every == 0:
                 checkpoint()
     env.close()
-    if session.stop_requested:
-        checkpoint()
-        raise session.interrupted()
     checkpoint()
+    if session.stop_requested:
+        raise session.interrupted()
     return session.finish(lambda folder: [agent.save(folder)], agent.q_network.set_weights)
 
 

@@ -1,0 +1,96 @@
+#!/usr/bin/env python3
+"""CartPole speed, one JSON line per measurement.
+
+  python benchmarks/cartpole.py              # env floor + pool scaling (no TensorFlow needed)
+  python benchmarks/cartpole.py --train a2c  # also: train the default preset, wall time and steps/s
+
+Measurements:
+  env_random   one in-process CartPole-v1 env, random actions: the floor
+  pool         agent steps/s of the env pool, inline vs processes, with 1, 2, 4, 8 envs
+  train        env steps/s and wall seconds of a training run (default preset), and its best evaluation
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+from functools import partial
+from pathlib import Path
+
+os.environ.setdefault("TF_CPP_MIN_LOG_LEVEL", "3")
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+import numpy as np  # noqa: E402
+
+from cartpole.experiment import make_env  # noqa: E402
+
+
+def emit(**row):
+    print(json.dumps(row), flush=True)
+
+
+def bench_env(seconds=3.0):
+    env = make_env()
+    env.reset(seed=0)
+    rng = np.random.default_rng(0)
+    steps, start = 0, time.perf_counter()
+    while time.perf_counter() - start < seconds:
+        _, _, terminated, truncated, _ = env.step(int(rng.integers(2)))
+        steps += 1
+        if terminated or truncated:
+            env.reset()
+    emit(bench="env_random", env="CartPole-v1", steps_per_s=round(steps / (time.perf_counter() - start)))
+
+
+def bench_pool(seconds=3.0):
+    from rlcore.vector import EnvPool
+
+    rng = np.random.default_rng(0)
+    for mode in ("inline", "processes"):
+        for n in (1, 2, 4, 8):
+            started = time.perf_counter()
+            with EnvPool([partial(make_env)] * n, mode=mode) as pool:
+                pool.reset(seed=0)
+                startup = time.perf_counter() - started
+                vector_steps, start = 0, time.perf_counter()
+                while time.perf_counter() - start < seconds:
+                    pool.step(rng.integers(0, 2, n))
+                    vector_steps += 1
+                elapsed = time.perf_counter() - start
+            emit(bench="pool", env="CartPole-v1", mode=mode, num_envs=n, startup_s=round(startup, 2),
+                 agent_steps_per_s=round(vector_steps * n / elapsed))
+
+
+def bench_train(algo: str, experiment: str):
+    import importlib
+    import tempfile
+
+    from rlcore.experiment import get_experiment
+    from rlcore.trainers.session import RunSpec
+
+    exp = get_experiment(experiment)
+    cfg = exp.preset(algo, "default")
+    spec = RunSpec(exp, algo, "default", cfg, 0, "off", Path(tempfile.mkdtemp(prefix="bench_")),
+                   command="benchmark", progress=False)
+    model_dir = importlib.import_module(f"rlcore.trainers.{exp.algo(algo).kind}").train(spec)
+    meta = json.loads((model_dir / "meta.json").read_text())
+    emit(bench="train", experiment=experiment, algo=algo, preset="default", seed=0,
+         env_steps=meta["env_steps"], wall_seconds=meta["wall_seconds"],
+         env_steps_per_s=round(meta["env_steps"] / meta["wall_seconds"]), best_eval=meta["best_eval"])
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--train", choices=["dqn", "a2c"], default=None)
+    parser.add_argument("--experiment", default="cartpole", choices=["cartpole", "cartpole_v0"])
+    args = parser.parse_args()
+    bench_env()
+    bench_pool()
+    if args.train:
+        bench_train(args.train, args.experiment)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,55 @@
+"""Every shipped model loads from its .h5, clears its bar on seeded episodes, and carries its story."""
+from pathlib import Path
+
+import imageio.v3 as iio
+import pytest
+
+from rlcore.evaluation import evaluate
+from rlcore.experiment import experiment_names, get_experiment
+from rlcore.policies import load_policy
+from rlcore.video import record_video
+
+SHIPPED = Path(__file__).resolve().parents[1] / "saved_networks"
+# SPEC.md "our bar", greedy mean return
+BARS = {
+    ("lunar_lander", "dqn"): 230.0, ("lunar_lander", "ddqn"): 230.0,
+    ("lunar_lander", "dueling_dqn"): 230.0, ("lunar_lander", "dueling_ddqn"): 230.0,
+    ("lunar_lander", "a2c"): 200.0,
+    ("cartpole", "dqn"): 500.0, ("cartpole", "a2c"): 500.0, ("cartpole_v0", "a2c"): 200.0,
+}
+
+
+def test_every_bar_names_a_registered_algorithm():
+    for experiment, algo in BARS:
+        get_experiment(experiment).algo(algo)
+
+
+def test_no_model_is_shipped_without_a_bar():
+    for name in experiment_names():
+        for algo in get_experiment(name).algos:
+            if (SHIPPED / name / algo / "meta.json").exists():
+                assert (name, algo) in BARS
+
+
+@pytest.mark.parametrize("experiment, algo", sorted(BARS))
+def test_shipped_model_meets_its_bar(experiment, algo):
+    bar = BARS[experiment, algo]
+    exp, meta, policy = load_policy(SHIPPED / experiment / algo, experiment, algo)
+    # the recorded story: our own training command, seed, budget, time, a 100-episode evaluation
+    assert meta["command"].startswith(f"python main.py train {experiment} {algo}")
+    for key in ("seed", "env_steps", "episodes", "wall_seconds", "config", "versions"):
+        assert key in meta, key
+    assert meta["evaluation"]["episodes"] == 100 and meta["evaluation"]["mean"] >= bar
+    # and it still plays: 5 seeded episodes from the unseen-seed range
+    returns = evaluate(exp, policy, episodes=5, progress=False)
+    assert returns.mean() >= bar, f"{experiment} {algo}: {returns.round(1)}"
+
+
+def test_render_of_a_shipped_model_is_a_decodable_mp4(tmp_path):
+    exp, meta, policy = load_policy(SHIPPED / "lunar_lander" / "dqn")
+    out = tmp_path / "dqn.mp4"
+    result = record_video(exp, policy, out, fps=30)
+    frames = iio.imread(out)
+    assert len(frames) == result["frames"] > 10
+    assert frames.shape[1:] == (400, 600, 3)
+    assert iio.immeta(out)["fps"] == pytest.approx(30)
