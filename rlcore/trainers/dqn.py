@@ -53,9 +53,8 @@ def train(spec: RunSpec) -> Path:
             first_seed = None  # later episodes continue the env's own RNG
             episode_return, losses = 0.0, []
             while True:
-                if cfg.eps_schedule == "steps":  # the PyTorch tutorial: exponential in actions taken
-                    epsilon = cfg.eps_end + (cfg.eps_start - cfg.eps_end) * math.exp(
-                        -session.env_steps / cfg.eps_decay_steps)
+                if cfg.eps_schedule == "steps":
+                    epsilon = step_epsilon(cfg, session.env_steps)
                 action = agent.act(obs, epsilon, rng)
                 next_obs, reward, terminated, truncated, _ = env.step(action)
                 memory.add(obs, action, reward, next_obs, terminated)
@@ -85,6 +84,11 @@ def train(spec: RunSpec) -> Path:
     if session.stop_requested:
         raise session.interrupted()
     return session.finish(lambda folder: [agent.save(folder)], agent.q_network.set_weights)
+
+
+def step_epsilon(cfg, env_steps: int) -> float:
+    """The PyTorch tutorial's schedule: end + (start - end) * exp(-steps / decay_steps)."""
+    return cfg.eps_end + (cfg.eps_start - cfg.eps_end) * math.exp(-env_steps / cfg.eps_decay_steps)
 
 
 def _train_steps(agent: DQNAgent, batch, env_steps: int) -> dict:

@@ -162,3 +162,12 @@ def test_saved_model_loads_with_shape_checks(tmp_path):
         load_keras_model(path, OBS + 1, ACTIONS)
     with pytest.raises(UserError, match="outputs"):
         load_keras_model(path, OBS, ACTIONS + 1)
+
+
+def test_tutorial_epsilon_schedule():
+    from cartpole.experiment import DQN_ARTICLE
+    from rlcore.trainers.dqn import step_epsilon
+
+    assert step_epsilon(DQN_ARTICLE, 0) == pytest.approx(0.9)
+    assert step_epsilon(DQN_ARTICLE, 1000) == pytest.approx(0.05 + 0.85 / np.e)
+    assert step_epsilon(DQN_ARTICLE, 100_000) == pytest.approx(0.05, abs=1e-12)
