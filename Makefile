@@ -16,10 +16,10 @@ $(STAMP): setup.cfg pyproject.toml
 
 venv: $(STAMP)
 
-# Train the default experiment (LunarLander DQN, default preset) until solved, then
-# write its plot and an MP4 of the trained agent.
+# Train the default experiment (LunarLander DQN, default preset) until solved, evaluate it,
+# then write its plot and an MP4 of the trained agent. wandb: online if logged in, else offline.
 demo: $(STAMP)
-	$(PY) main.py train lunar_lander dqn --wandb offline --video
+	$(PY) main.py train lunar_lander dqn --video
 
 test: $(STAMP)
 	$(PY) -m pytest -q
@@ -28,8 +28,10 @@ test: $(STAMP)
 test-all: $(STAMP)
 	$(PY) -m pytest -q -m ""
 
+# Speed measurements, one JSON line each (several minutes: they train to solved).
 benchmark: $(STAMP)
 	$(PY) benchmarks/lunar_lander.py dqn
+	$(PY) benchmarks/cartpole.py --train a2c
 
 clean:
 	rm -rf runs wandb videos .pytest_cache
