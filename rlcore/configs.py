@@ -25,6 +25,7 @@ class RunBudget:
                                   "seeds (0 = off); written to evals.csv")
     eval_episodes: int = _h(10, "episodes per periodic evaluation")
     keep_best: bool = _h(False, "save the weights of the best periodic evaluation, not the last ones")
+    stop_eval_score: float = _h(0.0, "stop once a periodic evaluation's mean reaches this (0 = off)")
 
 
 @dataclass(frozen=True)

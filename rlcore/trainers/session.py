@@ -190,6 +190,8 @@ class TrainingSession:
             return True
         if cfg.max_env_steps and self.env_steps >= cfg.max_env_steps:
             return True
+        if cfg.stop_eval_score and self.best_eval and self.best_eval["mean"] >= cfg.stop_eval_score:
+            return True
         return self.book.full_window() and self.book.average >= cfg.stop_score
 
     def state(self, **extra) -> dict:

@@ -98,3 +98,11 @@ def test_periodic_evaluation_keeps_the_best_weights(algo, tmp_path):
     exp, _, policy = load_policy(model_dir)
     again = evaluate(exp, policy, 4, seed_base=exp.selection_seed_base, max_episode_steps=10, progress=False)
     assert again.mean() == pytest.approx(best)
+
+
+def test_training_stops_when_an_evaluation_reaches_the_stop_eval_score(tmp_path):
+    spec = toy.spec("dqn", tmp_path, eval_every_steps=100, eval_episodes=4, keep_best=True,
+                    stop_score=99.0, stop_eval_score=9.0, max_episodes=200)
+    meta = json.loads((dqn_trainer.train(spec) / "meta.json").read_text())
+    assert meta["best_eval"]["mean"] >= 9.0
+    assert meta["episodes"] < 200
