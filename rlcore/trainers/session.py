@@ -246,12 +246,13 @@ class TrainingSession:
         model_dir.mkdir(parents=True, exist_ok=True)
         files = [p.name for p in save_models(model_dir)]
         exp, s = self.spec.experiment, self.spec
-        plot_name = f"{exp.extra.get('plot_prefix', exp.name)}_Train_{s.algo}.png"
+        prefix = exp.extra.get("plot_prefix", exp.name)
+        plot_name = f"{prefix}_Train_{s.algo}.png"
         title = f"{exp.name} {s.algo} ({s.preset} preset, seed {s.seed})"
         label = exp.extra.get("score_label", "return")
         plot_episode_scores(self.tracker.csv_path, model_dir / plot_name, title, exp.solved_score, label)
         if self.tracker.table_path("evals").exists():
-            plot_evaluations(self.tracker.table_path("evals"), model_dir / f"{exp.name}_Eval_{s.algo}.png",
+            plot_evaluations(self.tracker.table_path("evals"), model_dir / f"{prefix}_Eval_{s.algo}.png",
                              title, exp.solved_score, label)
         for table in ("metrics", "evals"):
             if self.tracker.table_path(table).exists():
