@@ -12,6 +12,8 @@ Measurements:
 from __future__ import annotations
 
 import argparse
+import contextlib
+import dataclasses
 import json
 import os
 import sys
@@ -63,7 +65,7 @@ def bench_pool(seconds=3.0):
                  agent_steps_per_s=round(vector_steps * n / elapsed))
 
 
-def bench_train(algo: str, experiment: str):
+def bench_train(algo: str, experiment: str, no_eval: bool = False):
     import importlib
     import tempfile
 
@@ -72,11 +74,14 @@ def bench_train(algo: str, experiment: str):
 
     exp = get_experiment(experiment)
     cfg = exp.preset(algo, "default")
+    if no_eval:  # the training loop alone: article 002 tests 10 episodes every 800 env steps
+        cfg = dataclasses.replace(cfg, eval_every_steps=0, keep_best=False)
     spec = RunSpec(exp, algo, "default", cfg, 0, "off", Path(tempfile.mkdtemp(prefix="bench_")),
                    command="benchmark", progress=False)
-    model_dir = importlib.import_module(f"rlcore.trainers.{exp.algo(algo).kind}").train(spec)
+    with contextlib.redirect_stdout(sys.stderr):  # stdout carries only the JSON lines
+        model_dir = importlib.import_module(f"rlcore.trainers.{exp.algo(algo).kind}").train(spec)
     meta = json.loads((model_dir / "meta.json").read_text())
-    emit(bench="train", experiment=experiment, algo=algo, preset="default", seed=0,
+    emit(bench="train", experiment=experiment, algo=algo, preset="default", seed=0, periodic_eval=not no_eval,
          env_steps=meta["env_steps"], wall_seconds=meta["wall_seconds"],
          env_steps_per_s=round(meta["env_steps"] / meta["wall_seconds"]), best_eval=meta["best_eval"])
 
@@ -85,11 +90,14 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--train", choices=["dqn", "a2c"], default=None)
     parser.add_argument("--experiment", default="cartpole", choices=["cartpole", "cartpole_v0"])
+    parser.add_argument("--no-eval", action="store_true", help="train without the periodic evaluations")
+    parser.add_argument("--skip-pool", action="store_true", help="skip the env and pool measurements")
     args = parser.parse_args()
-    bench_env()
-    bench_pool()
+    if not args.skip_pool:
+        bench_env()
+        bench_pool()
     if args.train:
-        bench_train(args.train, args.experiment)
+        bench_train(args.train, args.experiment, args.no_eval)
 
 
 if __name__ == "__main__":

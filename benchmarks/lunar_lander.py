@@ -13,6 +13,7 @@ Measurements:
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import json
 import os
@@ -94,7 +95,8 @@ def bench_train_to_solved(algo: str, seed: int, max_seconds: float):
     TrainingSession.should_stop = lambda self: original(self) or self.elapsed() > max_seconds
     start = time.perf_counter()
     try:
-        model_dir = importlib.import_module(f"rlcore.trainers.{kind}").train(spec)
+        with contextlib.redirect_stdout(sys.stderr):  # stdout carries only the JSON lines
+            model_dir = importlib.import_module(f"rlcore.trainers.{kind}").train(spec)
         meta = json.loads((model_dir / "meta.json").read_text())
     except Interrupted:
         meta = None
