@@ -14,6 +14,7 @@ pool closes the rest: no hang, no process left behind.
 from __future__ import annotations
 
 import multiprocessing
+import warnings
 from typing import Callable, Sequence
 
 import gymnasium as gym
@@ -108,10 +109,12 @@ class EnvPool:
             return
         self.closed = True
         if self.mode == "processes":
-            try:
-                self.envs.close(terminate=terminate, timeout=None if terminate else 10)
-            except Exception:
-                self.envs.close(terminate=True)
+            with warnings.catch_warnings():  # "close while waiting for step": expected after a death
+                warnings.simplefilter("ignore")
+                try:
+                    self.envs.close(terminate=terminate, timeout=None if terminate else 10)
+                except Exception:
+                    self.envs.close(terminate=True)
         else:
             self.envs.close()
 
