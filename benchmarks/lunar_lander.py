@@ -26,25 +26,13 @@ os.environ.setdefault("TF_CPP_MIN_LOG_LEVEL", "3")
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import numpy as np  # noqa: E402
+from common import emit, random_env_rate  # noqa: E402
 
 from lunar_lander.experiment import EXPERIMENT  # noqa: E402
 
 
-def emit(**row):
-    print(json.dumps(row), flush=True)
-
-
-def bench_env(seconds: float = 5.0):
-    env = EXPERIMENT.make_env()
-    env.reset(seed=0)
-    rng = np.random.default_rng(0)
-    steps, start = 0, time.perf_counter()
-    while time.perf_counter() - start < seconds:
-        _, _, terminated, truncated, _ = env.step(int(rng.integers(4)))
-        steps += 1
-        if terminated or truncated:
-            env.reset()
-    emit(bench="env_random", env="LunarLander-v3", steps_per_s=round(steps / (time.perf_counter() - start)))
+def bench_env():
+    emit(bench="env_random", env="LunarLander-v3", steps_per_s=random_env_rate(EXPERIMENT.make_env))
 
 
 def _time(fn, n):

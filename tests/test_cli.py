@@ -159,3 +159,12 @@ def test_every_algorithm_builds_its_train_parser(capsys):
                 parser = main.build_parser(["train", name, algo, "--preset", preset])
                 args = parser.parse_args(["train", name, algo, "--preset", preset])
                 assert args.algo == algo
+
+
+@pytest.mark.parametrize("script", ["lunar_lander.py", "cartpole.py"])
+def test_benchmark_scripts_start(script):
+    """Imports and --help only: the measurements themselves are not tests."""
+    done = subprocess.run([sys.executable, str(ROOT / "benchmarks" / script), "--help"], cwd=ROOT,
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert "JSON" in done.stdout
