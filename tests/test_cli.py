@@ -1,7 +1,6 @@
 """main.py end to end: commands, and every bad input giving one clear line and a non-zero exit."""
 import json
 import os
-import shutil
 import subprocess
 import sys
 from pathlib import Path

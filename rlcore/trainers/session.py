@@ -22,6 +22,7 @@ from rlcore.errors import UserError
 from rlcore.hparams import to_dict
 from rlcore.plotting import plot_episode_scores, plot_evaluations
 from rlcore.tracking import Tracker
+from rlcore.trainers.episodes import EpisodeBook
 
 RUNS_DIR = Path("runs")
 CHECKPOINT_FILE = "checkpoint.npz"
@@ -82,38 +83,6 @@ def package_versions() -> dict:
     import tensorflow as tf
     return {"python": platform.python_version(), "tensorflow": tf.__version__, "keras": keras.__version__,
             "gymnasium": gymnasium.__version__, "numpy": np.__version__}
-
-
-class EpisodeBook:
-    """Episode returns, the moving average, and the article's console line and wandb keys."""
-
-    def __init__(self, window: int, solved_score: float, returns: list[float] | None = None):
-        self.window, self.solved_score = window, solved_score
-        self.returns: list[float] = list(returns or [])
-        self.solved_episode: int | None = None
-
-    @property
-    def episodes(self) -> int:
-        return len(self.returns)
-
-    @property
-    def average(self) -> float:
-        return float(np.mean(self.returns[-self.window:])) if self.returns else float("nan")
-
-    def full_window(self) -> bool:
-        return len(self.returns) >= self.window
-
-    def add(self, episode_return: float) -> dict:
-        """Record one episode; return the article's per-episode metrics."""
-        self.returns.append(float(episode_return))
-        if self.solved_episode is None and self.full_window() and self.average >= self.solved_score:
-            self.solved_episode = self.episodes
-            tqdm.write(f"\nEnvironment solved in {self.episodes} episodes!")
-        if self.episodes % self.window == 0:
-            tqdm.write(f"Episode {self.episodes} | Total point average of the last {self.window} "
-                       f"episodes: {self.average:.2f}")
-        return {"episode": self.episodes, "total_points": float(episode_return),
-                "av_latest_points": self.average, "target_ave_scores": self.solved_score}
 
 
 class TrainingSession:

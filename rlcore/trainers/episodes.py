@@ -1,0 +1,37 @@
+"""Episode book-keeping as article 000 does it: returns, the moving average, its console lines."""
+from __future__ import annotations
+
+import numpy as np
+from tqdm import tqdm
+
+
+class EpisodeBook:
+    """Episode returns, the moving average, and the article's console line and wandb keys."""
+
+    def __init__(self, window: int, solved_score: float, returns: list[float] | None = None):
+        self.window, self.solved_score = window, solved_score
+        self.returns: list[float] = list(returns or [])
+        self.solved_episode: int | None = None
+
+    @property
+    def episodes(self) -> int:
+        return len(self.returns)
+
+    @property
+    def average(self) -> float:
+        return float(np.mean(self.returns[-self.window:])) if self.returns else float("nan")
+
+    def full_window(self) -> bool:
+        return len(self.returns) >= self.window
+
+    def add(self, episode_return: float) -> dict:
+        """Record one episode; return the article's per-episode metrics."""
+        self.returns.append(float(episode_return))
+        if self.solved_episode is None and self.full_window() and self.average >= self.solved_score:
+            self.solved_episode = self.episodes
+            tqdm.write(f"\nEnvironment solved in {self.episodes} episodes!")
+        if self.episodes % self.window == 0:
+            tqdm.write(f"Episode {self.episodes} | Total point average of the last {self.window} "
+                       f"episodes: {self.average:.2f}")
+        return {"episode": self.episodes, "total_points": float(episode_return),
+                "av_latest_points": self.average, "target_ave_scores": self.solved_score}
