@@ -63,11 +63,10 @@ def _spec_from_args(args):
         spec = RunSpec(exp, args.algo, args.preset or "", None, args.seed, args.wandb, run_dir, True,
                        progress=not args.no_progress)
         state = check_resumable(spec)
-        from rlcore.configs import A2CConfig, DQNConfig
         from rlcore.hparams import from_dict
-        cls = {"dqn": DQNConfig, "a2c": A2CConfig}[spec.kind]
+        config_class = type(exp.preset(args.algo, None))
         # the checkpoint's own hyperparameters; budgets may be raised from the command line
-        spec.config = apply_overrides(from_dict(cls, state["config"]), overrides)
+        spec.config = apply_overrides(from_dict(config_class, state["config"]), overrides)
         spec.preset, spec.seed = state["preset"], state["seed"]
         print(f"resuming {run_dir} at episode {len(state['returns'])}, env step {state['env_steps']}")
         return spec

@@ -19,7 +19,7 @@ import tensorflow as tf
 from keras import layers
 
 from rlcore.configs import A2CConfig
-from rlcore.models import save_keras_model
+from rlcore.models import numpy_relu_trunk, save_keras_model
 
 _PROB_FLOOR = 1e-8  # keeps log(p) finite when the softmax saturates
 
@@ -191,10 +191,7 @@ class A2CAgent:
 
 def numpy_actor_probs(weights: list[np.ndarray], obs: np.ndarray) -> np.ndarray:
     """The actor's forward pass in numpy (ReLU hidden layers, softmax output)."""
-    x = obs
-    for kernel, bias in zip(weights[:-2:2], weights[1:-2:2]):
-        x = np.maximum(x @ kernel + bias, 0.0)
-    logits = x @ weights[-2] + weights[-1]
+    logits = numpy_relu_trunk(weights[:-2], obs) @ weights[-2] + weights[-1]
     logits -= logits.max(axis=1, keepdims=True)
     e = np.exp(logits)
     return e / e.sum(axis=1, keepdims=True)

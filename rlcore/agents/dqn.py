@@ -15,7 +15,7 @@ from keras import layers
 
 from rlcore.configs import DQNConfig
 from rlcore.layers import DuelingCombine
-from rlcore.models import save_keras_model
+from rlcore.models import numpy_relu_trunk, save_keras_model
 
 
 def build_q_network(obs_dim: int, n_actions: int, hidden=(64, 64), dueling: bool = False,
@@ -39,10 +39,7 @@ def numpy_q_values(weights: list[np.ndarray], obs: np.ndarray, dueling: bool) ->
 
     Used for fast acting and as the reference the Keras model is tested against.
     """
-    n_head = 4 if dueling else 2
-    x = obs
-    for kernel, bias in zip(weights[:-n_head:2], weights[1:-n_head:2]):
-        x = np.maximum(x @ kernel + bias, 0.0)
+    x = numpy_relu_trunk(weights[:-4 if dueling else -2], obs)
     if not dueling:
         return x @ weights[-2] + weights[-1]
     value = x @ weights[-4] + weights[-3]
@@ -124,7 +121,7 @@ class DQNAgent:
                      for g in grads]
         self.optimizer.apply_gradients(zip(grads, self.q_network.trainable_variables))
         self.soft_update()
-        return {"loss": loss, "q_mean": tf.reduce_mean(q_taken)}, self.q_network.weights
+        return {"loss": loss, "q_mean": tf.reduce_mean(q_taken)}
 
     def soft_update(self):
         """target <- tau * online + (1 - tau) * target."""
@@ -139,7 +136,7 @@ class DQNAgent:
         """
         if n_updates not in self._compiled_updates:
             def updates(obs, action, reward, next_obs, terminated):
-                history = [self._train_graph(obs[i], action[i], reward[i], next_obs[i], terminated[i])[0]
+                history = [self._train_graph(obs[i], action[i], reward[i], next_obs[i], terminated[i])
                            for i in range(n_updates)]
                 means = {k: tf.reduce_mean(tf.stack([h[k] for h in history])) for k in history[0]}
                 return means, self.q_network.weights
