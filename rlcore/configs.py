@@ -74,3 +74,31 @@ class A2CConfig(RunBudget):
     entropy_coef: float = _h(0.0, "entropy bonus weight in the actor loss")
     max_grad_norm: float = _h(0.0, "clip gradients by global norm (0 = off)")
     normalize_advantage: bool = _h(False, "standardize advantages within each update")
+
+
+@dataclass(frozen=True)
+class PPOConfig(RunBudget):
+    """PPO with clipped surrogate, GAE and a shared CNN feature (article 001).
+
+    One update = ``epochs`` passes over a rollout of ``n_steps`` x ``num_envs`` transitions in
+    shuffled minibatches. ``article_quirks`` restores the article's loss: ratio p / (p_old + 1e-3)
+    instead of exp(log p - log p_old), and log p(a) of the taken action in place of the entropy.
+    """
+    num_envs: int = _h(8, "environments stepped together")
+    vec: str = _h("processes", "processes (one per env, over Pipes) | inline (one process)")
+    n_steps: int = _h(512, "env steps per env in one rollout")
+    epochs: int = _h(10, "passes over each rollout")
+    minibatch: int = _h(256, "transitions per gradient step")
+    lr: float = _h(1e-4, "Adam learning rate")
+    gamma: float = _h(0.99, "discount factor")
+    gae_lambda: float = _h(0.97, "GAE lambda")
+    clip: float = _h(0.2, "PPO clip range of the probability ratio")
+    entropy_coef: float = _h(0.05, "entropy bonus weight")
+    value_coef: float = _h(1.0, "value loss weight (the article adds it unweighted)")
+    value_target: str = _h("gae", "gae: advantage + V(s) (the lambda-return) | td0: r + gamma V(s')")
+    max_grad_norm: float = _h(0.0, "clip gradients by global norm (0 = off)")
+    normalize_advantage: bool = _h(False, "standardize advantages within each minibatch")
+    article_quirks: bool = _h(False, "the article's ratio p/(p_old+1e-3) and log p(a) as entropy")
+    checkpoint_rollouts: int = _h(10, "rollouts between checkpoints")
+    stop_success_share: float = _h(0.0, "stop once this share of the last `window` episodes "
+                                        "succeeded, e.g. reached the flag (0 = off)")

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import importlib
 from dataclasses import dataclass, field
+from functools import partial
 from typing import Callable
 
 from rlcore.errors import UserError
@@ -16,6 +17,7 @@ EXPERIMENT_MODULES = {
     "lunar_lander": "lunar_lander.experiment",
     "cartpole": "cartpole.experiment",
     "cartpole_v0": "cartpole.experiment_v0",
+    "mario_ppo": "mario_ppo.experiment",
 }
 
 
@@ -23,7 +25,7 @@ EXPERIMENT_MODULES = {
 class AlgoSpec:
     """One algorithm of an experiment: which trainer runs it and its named presets."""
     name: str
-    kind: str  # trainer / policy family: "dqn" | "a2c"
+    kind: str  # trainer / policy family: "dqn" | "a2c" | "ppo"
     description: str
     presets: dict  # preset name -> config dataclass instance
     default_preset: str = "default"
@@ -35,11 +37,24 @@ class Experiment:
     description: str
     make_env: Callable  # make_env(render_mode=None, max_episode_steps=None) -> gymnasium.Env
     algos: dict[str, AlgoSpec]
-    solved_score: float
+    solved_score: float | None  # None: no return threshold (Mario's success is the flag)
     eval_seed_base: int = 1_000_000  # final evaluation seeds start here; training never uses them
     selection_seed_base: int = 2_000_000  # periodic evaluations during training (model selection)
     video_fps: int = 30
     extra: dict = field(default_factory=dict)
+
+    def env_factory(self, config=None, **kwargs) -> Callable:
+        """A picklable no-argument env constructor for ``config`` (env-pool workers call it).
+
+        Experiments whose env depends on hyperparameters (Mario: world, stage, action set) list
+        those fields in ``extra["env_fields"]``.
+        """
+        for name in self.extra.get("env_fields", ()):
+            if config is not None:
+                kwargs.setdefault(name, getattr(config, name))
+        if config is not None:
+            kwargs.setdefault("max_episode_steps", config.max_episode_steps or None)
+        return partial(self.make_env, **kwargs)
 
     def algo(self, name: str) -> AlgoSpec:
         if name not in self.algos:

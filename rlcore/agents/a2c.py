@@ -18,6 +18,7 @@ import numpy as np
 import tensorflow as tf
 from keras import layers
 
+from rlcore.agents.advantages import gae
 from rlcore.configs import A2CConfig
 from rlcore.models import numpy_relu_trunk, save_keras_model
 
@@ -91,20 +92,6 @@ class Critic:
             loss = tf.debugging.check_numerics(self.compute_loss(v_pred, td_targets), "A2C critic loss")
         _apply(self.opt, self.model, tape, loss, self.max_grad_norm)
         return loss
-
-
-def gae(rewards, values, next_values, terminated, dones, gamma: float, lam: float):
-    """Advantages over a [T, N] rollout, as a graph (T is static).
-
-    delta_t = r_t + gamma * (1 - terminated_t) * V(s'_t) - V(s_t)
-    A_t     = delta_t + gamma * lam * (1 - done_t) * A_{t+1}
-    """
-    deltas = rewards + gamma * (1.0 - terminated) * next_values - values
-    advantages, running = [], tf.zeros_like(deltas[0])
-    for t in reversed(range(deltas.shape[0])):
-        running = deltas[t] + gamma * lam * (1.0 - dones[t]) * running
-        advantages.append(running)
-    return tf.stack(advantages[::-1])
 
 
 class A2CAgent:

@@ -8,7 +8,7 @@ from tqdm import tqdm
 class EpisodeBook:
     """Episode returns, the moving average, and the article's console line and wandb keys."""
 
-    def __init__(self, window: int, solved_score: float, returns: list[float] | None = None):
+    def __init__(self, window: int, solved_score: float | None, returns: list[float] | None = None):
         self.window, self.solved_score = window, solved_score
         self.returns: list[float] = list(returns or [])
         self.solved_episode: int | None = None
@@ -27,7 +27,8 @@ class EpisodeBook:
     def add(self, episode_return: float) -> dict:
         """Record one episode; return the article's per-episode metrics."""
         self.returns.append(float(episode_return))
-        if self.solved_episode is None and self.full_window() and self.average >= self.solved_score:
+        if (self.solved_score is not None and self.solved_episode is None and self.full_window()
+                and self.average >= self.solved_score):
             self.solved_episode = self.episodes
             tqdm.write(f"\nEnvironment solved in {self.episodes} episodes!")
         if self.episodes % self.window == 0:

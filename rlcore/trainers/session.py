@@ -88,7 +88,7 @@ def package_versions() -> dict:
 class TrainingSession:
     """Context for one run: owns the tracker, progress bar, book and the Ctrl-C flag."""
 
-    def __init__(self, spec: RunSpec, resumed_state: dict | None = None):
+    def __init__(self, spec: RunSpec, resumed_state: dict | None = None, progress_unit: str = "episode"):
         self.spec = spec
         exp, cfg = spec.experiment, spec.config
         self.run_dir = spec.run_dir
@@ -106,7 +106,12 @@ class TrainingSession:
         self.next_eval_step = int(state.get("next_eval_step", cfg.eval_every_steps))
         self.tracker = Tracker(self.run_dir, self.run_dir.name, self.describe(), spec.wandb_mode,
                                wandb_id=state.get("wandb_id"))
-        self.progress = tqdm(total=cfg.max_episodes, initial=self.book.episodes, unit="ep",
+        # the bar counts episodes (DQN, A2C) or env steps (PPO: long episodes, a step budget)
+        self.progress_unit = progress_unit
+        by_steps = progress_unit == "step"
+        self.progress = tqdm(total=(cfg.max_env_steps or None) if by_steps else cfg.max_episodes,
+                             initial=self.env_steps if by_steps else self.book.episodes,
+                             unit="step" if by_steps else "ep", unit_scale=by_steps,
                              disable=None if spec.progress else True, dynamic_ncols=True, leave=True)
 
     # ------------------------------------------------------------ bookkeeping
@@ -124,9 +129,18 @@ class TrainingSession:
         row.update(env_steps=self.env_steps, wall_seconds=round(self.elapsed(), 2), **extra)
         self.tracker.log(row)
         rate = (self.env_steps - self._steps_at_start) / max(time.perf_counter() - self._started, 1e-9)
-        self.progress.update(1)
-        self.progress.set_postfix(avg100=f"{self.book.average:.1f}", steps=self.env_steps,
-                                  sps=f"{rate:.0f}", refresh=False)
+        if self.progress_unit == "episode":
+            self.progress.update(1)
+            self.progress.set_postfix(avg100=f"{self.book.average:.1f}", steps=self.env_steps,
+                                      sps=f"{rate:.0f}", refresh=False)
+        else:
+            self.progress.set_postfix(episodes=self.book.episodes, avg100=f"{self.book.average:.1f}",
+                                      refresh=False)
+
+    def advance(self, steps: int) -> None:
+        """Move a step-counting progress bar (``progress_unit="step"``)."""
+        if self.progress_unit == "step":
+            self.progress.update(steps)
 
     def maybe_evaluate(self, greedy_policy, snapshot) -> None:
         """Every ``eval_every_steps`` env steps: greedy episodes on the fixed selection seeds.

@@ -3,7 +3,8 @@ import numpy as np
 import pytest
 import tensorflow as tf
 
-from rlcore.agents.a2c import A2CAgent, Actor, Critic, gae, numpy_actor_probs
+from rlcore.agents.a2c import A2CAgent, Actor, Critic, numpy_actor_probs
+from rlcore.agents.advantages import gae
 from rlcore.configs import A2CConfig
 from tests import numpy_reference as ref
 

@@ -1,0 +1,147 @@
+"""Super Mario Bros on the real NES emulator (nes-py 9 / gym-super-mario-bros 9), wrapped as article 001.
+
+Stack, innermost first::
+
+    SuperMarioBros-<world>-<stage>-v0        the emulator, one NES frame per step
+    JoypadSpace(SIMPLE_MOVEMENT | ...)       discrete button combinations
+    ClassicReward                            the reward gym-super-mario-bros had before 9.x
+    ArticleShaping                           +50 flag / -50 other ends, then / 10
+    SkipAndStack(4)                          one action for 4 frames, gray 84x84 frames as channels
+
+Observations are ``uint8 [84, 84, 4]``; the model scales them to [0, 1] itself. Auto-reset is the
+env pool's job (Gymnasium vector envs reset an env the step its episode ends).
+
+gym-super-mario-bros 9 pays a different reward (new-best x only, plus score, coins, power-ups and
+a completion term, unclipped). The article trained on the classic one, rebuilt here from ``info``:
+change of x (ignored when it jumps more than 5, e.g. on a warp), the clock's tick (-1 each time it
+decreases), -25 while dying or dead, the sum clipped to [-15, 15].
+
+TensorFlow-free: env-pool worker processes import this module.
+"""
+from __future__ import annotations
+
+import cv2
+import gymnasium as gym
+import numpy as np
+
+ACTION_SETS = ("simple", "complex", "right_only")
+FRAME_SIZE = 84
+INFO_KEYS = ("x_pos", "flag_get", "time", "world", "stage")  # what the wrappers pass on
+
+
+def action_list(name: str) -> list:
+    from gym_super_mario_bros import actions
+
+    table = {"simple": actions.SIMPLE_MOVEMENT, "complex": actions.COMPLEX_MOVEMENT,
+             "right_only": actions.RIGHT_ONLY}
+    if name not in table:
+        from rlcore.errors import UserError
+        raise UserError(f"unknown action set {name!r}; choose one of {', '.join(ACTION_SETS)}")
+    return table[name]
+
+
+def classic_reward(x_pos: int, x_last: int, time: int, time_last: int, dying: bool) -> float:
+    """The pre-9.x per-frame reward of gym-super-mario-bros, from two consecutive infos."""
+    dx = x_pos - x_last
+    if dx < -5 or dx > 5:  # a warp or a reset, not running
+        dx = 0
+    dt = min(time - time_last, 0)  # the clock only counts down; an increase is a reset
+    death = -25 if dying else 0
+    return float(np.clip(dx + dt + death, -15, 15))
+
+
+class ClassicReward(gym.Wrapper):
+    """Replace the env's reward with :func:`classic_reward`; keep the env's own in ``info``."""
+
+    def reset(self, *, seed=None, options=None):
+        obs, info = self.env.reset(seed=seed, options=options)
+        self._x_last, self._time_last = info["x_pos"], info["time"]
+        return obs, info
+
+    def step(self, action):
+        obs, env_reward, terminated, truncated, info = self.env.step(action)
+        reward = classic_reward(info["x_pos"], self._x_last, info["time"], self._time_last,
+                                info["is_dying"] or info["is_dead"])
+        self._x_last, self._time_last = info["x_pos"], info["time"]
+        info["env_reward"] = env_reward
+        return obs, reward, terminated, truncated, info
+
+
+class ArticleShaping(gym.Wrapper):
+    """+50 when the episode ends at the flag, -50 when it ends otherwise, then every reward / 10.
+
+    Only a real end (``terminated``) is shaped; a time-limit truncation is not an outcome.
+    """
+
+    def step(self, action):
+        obs, reward, terminated, truncated, info = self.env.step(action)
+        if terminated:
+            reward += 50.0 if info["flag_get"] else -50.0
+        return obs, reward / 10.0, terminated, truncated, info
+
+
+def gray_84(frame: np.ndarray) -> np.ndarray:
+    """RGB NES frame (240x256x3) -> gray uint8 84x84 (the article's cv2 gray + resize)."""
+    return cv2.resize(cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY), (FRAME_SIZE, FRAME_SIZE))
+
+
+class SkipAndStack(gym.Wrapper):
+    """Repeat each action for ``skip`` frames; observe those frames (gray 84x84) as channels.
+
+    Rewards of the skipped frames are summed. If the episode ends early, the last frame fills the
+    remaining channels. Reset shows the first frame ``skip`` times. ``info`` is trimmed to
+    :data:`INFO_KEYS` (less to send over the pool's Pipes). With ``render_mode="rgb_array"``, every
+    emulator frame of the last step is kept in ``self.frames`` for a full-rate video.
+    """
+
+    def __init__(self, env: gym.Env, skip: int = 4):
+        super().__init__(env)
+        self.skip = skip
+        self.observation_space = gym.spaces.Box(0, 255, (FRAME_SIZE, FRAME_SIZE, skip), np.uint8)
+        self.frames: list[np.ndarray] = []
+
+    def _keep(self, frame):
+        if self.env.render_mode == "rgb_array":
+            self.frames.append(frame)
+
+    def reset(self, *, seed=None, options=None):
+        frame, info = self.env.reset(seed=seed, options=options)
+        self.frames = []
+        self._keep(frame)
+        return np.repeat(gray_84(frame)[:, :, None], self.skip, axis=2), _trim(info)
+
+    def step(self, action):
+        obs = np.empty((FRAME_SIZE, FRAME_SIZE, self.skip), np.uint8)
+        total, terminated, truncated = 0.0, False, False
+        self.frames = []
+        for i in range(self.skip):
+            frame, reward, terminated, truncated, info = self.env.step(action)
+            self._keep(frame)
+            total += reward
+            obs[:, :, i] = gray_84(frame)
+            if terminated or truncated:
+                obs[:, :, i + 1:] = obs[:, :, i:i + 1]
+                break
+        return obs, total, terminated, truncated, _trim(info)
+
+
+def _trim(info: dict) -> dict:
+    return {k: info[k] for k in INFO_KEYS if k in info}
+
+
+def make_env(render_mode: str | None = None, max_episode_steps: int | None = None, world: int = 1,
+             stage: int = 1, actions: str = "simple", skip: int = 4) -> gym.Env:
+    """The article's Mario env for one stage. ``max_episode_steps`` counts agent steps (None = none)."""
+    import gym_super_mario_bros  # noqa: F401  registers the SuperMarioBros-* ids
+    from nes_py.wrappers import JoypadSpace
+
+    from rlcore.errors import UserError
+
+    if not (1 <= world <= 8 and 1 <= stage <= 4):
+        raise UserError(f"there is no level {world}-{stage}: world is 1-8, stage 1-4")
+    env = gym.make(f"SuperMarioBros-{world}-{stage}-v0", render_mode=render_mode).unwrapped
+    env = JoypadSpace(env, action_list(actions))
+    env = SkipAndStack(ArticleShaping(ClassicReward(env)), skip)
+    if max_episode_steps:
+        env = gym.wrappers.TimeLimit(env, max_episode_steps)
+    return env

@@ -1,0 +1,45 @@
+"""Super Mario Bros with PPO (article 001): presets and registration. TensorFlow-free.
+
+The level and action set are hyperparameters (``--world 1 --stage 1 --actions simple``), so
+they are recorded in every checkpoint and ``meta.json`` and a saved model rebuilds its own env.
+"""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+
+from mario_ppo.env import make_env
+from rlcore.configs import PPOConfig
+from rlcore.experiment import AlgoSpec, Experiment
+
+
+@dataclass(frozen=True)
+class MarioPPOConfig(PPOConfig):
+    world: int = field(default=1, metadata={"help": "world 1-8"})
+    stage: int = field(default=1, metadata={"help": "stage 1-4"})
+    actions: str = field(default="simple", metadata={"help": "simple | complex | right_only"})
+
+
+# Article 001: 8 envs x 512 steps, GAE gamma 0.99 lambda 0.97, clip 0.2, entropy 0.05, Adam 1e-4,
+# 10 epochs of minibatch 256, value loss added unweighted, TD(0) value target, its ratio and
+# entropy approximations, 200 rollouts, a checkpoint every 10.
+ARTICLE = MarioPPOConfig(
+    value_target="td0", article_quirks=True, max_env_steps=200 * 512 * 8, max_episodes=10**9,
+    max_episode_steps=0, stop_score=1e9, window=100)
+# Default: the same numbers with the quirks fixed (log-ratio, true entropy, lambda-return value
+# target), gradients clipped at norm 0.5, a 6M-step budget, and a stop once half of the last 100
+# training episodes reached the flag.
+DEFAULT = dataclasses.replace(
+    ARTICLE, value_target="gae", article_quirks=False, max_grad_norm=0.5, max_env_steps=6_000_000,
+    stop_success_share=0.5)
+
+EXPERIMENT = Experiment(
+    name="mario_ppo",
+    description="Super Mario Bros (NES emulator, 84x84x4 gray frames, 7/12/5 actions), article 001",
+    make_env=make_env,
+    solved_score=None,  # success is the flag, not a return
+    algos={"ppo": AlgoSpec("ppo", "ppo", "PPO, 8 envs over Pipes", {"article": ARTICLE, "default": DEFAULT})},
+    video_fps=60,
+    extra={"env_fields": ("world", "stage", "actions"), "success_key": "flag_get",
+           "progress_key": "x_pos", "score_label": "return (shaped, /10)"},
+)

@@ -1,0 +1,174 @@
+"""PPO with a shared CNN feature, a softmax policy head and a value head (article 001).
+
+The network reads ``uint8`` frame stacks and scales them to [0, 1] itself, so frames cross the
+env pool as bytes. It outputs policy logits (pi = softmax(logits)) and V(s).
+
+One update is one compiled call: GAE over the [T, N] rollout, then ``epochs`` passes of shuffled
+minibatches (the shuffles come from the trainer's numpy RNG, so a resumed run replays exactly).
+
+Loss per minibatch::
+
+    ratio  = exp(log pi(a|s) - log pi_old(a|s))
+    policy = -mean(min(ratio A, clip(ratio, 1 - eps, 1 + eps) A))
+    value  = mean((V(s) - target)^2)
+    loss   = policy + value_coef * value - entropy_coef * mean(H(pi(.|s)))
+
+``article_quirks`` swaps in the article's ratio pi / (pi_old + 1e-3) and its entropy stand-in,
+-log(pi(a|s) + 1e-3) of the taken action.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import keras
+import numpy as np
+import tensorflow as tf
+from keras import layers
+
+from rlcore.agents.advantages import gae
+from rlcore.configs import PPOConfig
+from rlcore.models import save_keras_model
+
+MODEL_FILE = "actor_critic.h5"
+_QUIRK_EPS = 1e-3  # the article's constant in pi / (pi_old + 1e-3) and log(pi + 1e-3)
+
+
+def build_actor_critic(obs_shape: tuple, n_actions: int) -> keras.Model:
+    """Feature: 4 x Conv2D(32, 3, stride 2, same, ReLU) -> Flatten -> Dense 512; then two heads."""
+    frames = keras.Input(obs_shape, dtype="uint8", name="frames")
+    x = layers.Rescaling(1.0 / 255.0, name="to_unit")(frames)
+    for i in range(4):
+        x = layers.Conv2D(32, 3, strides=2, padding="same", activation="relu", name=f"conv_{i}")(x)
+    x = layers.Flatten(name="flatten")(x)
+    x = layers.Dense(512, activation="relu", name="feature")(x)
+    logits = layers.Dense(n_actions, name="policy_logits")(x)
+    value = layers.Dense(1, name="value")(x)
+    return keras.Model(frames, [logits, value], name="actor_critic")
+
+
+def ppo_losses(logits, values, actions, logp_old, advantages, targets, cfg: PPOConfig):
+    """(total, policy, value, entropy, approx_kl, clip_fraction) of one minibatch."""
+    logp_all = tf.nn.log_softmax(logits)
+    logp = tf.gather(logp_all, actions, batch_dims=1)
+    if cfg.normalize_advantage:
+        advantages = (advantages - tf.reduce_mean(advantages)) / (tf.math.reduce_std(advantages) + 1e-8)
+    if cfg.article_quirks:
+        ratio = tf.exp(logp) / (tf.exp(logp_old) + _QUIRK_EPS)
+        entropy = -tf.reduce_mean(tf.math.log(tf.exp(logp) + _QUIRK_EPS))
+    else:
+        ratio = tf.exp(logp - logp_old)
+        entropy = -tf.reduce_mean(tf.reduce_sum(tf.exp(logp_all) * logp_all, axis=1))
+    clipped = tf.clip_by_value(ratio, 1.0 - cfg.clip, 1.0 + cfg.clip)
+    policy_loss = -tf.reduce_mean(tf.minimum(ratio * advantages, clipped * advantages))
+    value_loss = tf.reduce_mean(tf.square(values - targets))
+    total = policy_loss + cfg.value_coef * value_loss - cfg.entropy_coef * entropy
+    approx_kl = tf.reduce_mean(logp_old - logp)
+    clip_fraction = tf.reduce_mean(tf.cast(tf.abs(ratio - 1.0) > cfg.clip, tf.float32))
+    return total, policy_loss, value_loss, entropy, approx_kl, clip_fraction
+
+
+def rollout_targets(rewards, values, next_values, terminated, dones, cfg: PPOConfig):
+    """(advantages, value targets) of a [T, N] rollout."""
+    advantages = gae(rewards, values, next_values, terminated, dones, cfg.gamma, cfg.gae_lambda)
+    if cfg.value_target == "td0":
+        targets = rewards + cfg.gamma * (1.0 - terminated) * next_values
+    else:
+        targets = advantages + values
+    return advantages, targets
+
+
+LOSS_NAMES = ("loss", "policy_loss", "value_loss", "entropy", "approx_kl", "clip_fraction")
+
+
+class PPOAgent:
+    """Samples actions from pi (numpy RNG) and runs the whole PPO update as one compiled call."""
+
+    def __init__(self, obs_shape: tuple, n_actions: int, cfg: PPOConfig):
+        if cfg.value_target not in ("gae", "td0"):
+            from rlcore.errors import UserError
+            raise UserError(f"unknown value_target {cfg.value_target!r}; choose gae or td0")
+        self.obs_shape, self.n_actions, self.cfg = tuple(obs_shape), n_actions, cfg
+        self.model = build_actor_critic(self.obs_shape, n_actions)
+        self.opt = keras.optimizers.Adam(cfg.lr)
+        self.opt.build(self.model.trainable_variables)
+        frames = tf.TensorSpec([None, *self.obs_shape], tf.uint8)
+        self._forward = tf.function(lambda obs: self.model(obs), input_signature=[frames])
+        t, n = cfg.n_steps, cfg.num_envs
+        vec = tf.TensorSpec([t, n], tf.float32)
+        self._update = tf.function(self._update_graph, input_signature=[
+            tf.TensorSpec([t, n, *self.obs_shape], tf.uint8), tf.TensorSpec([t, n], tf.int32),
+            vec, vec, vec, vec, vec, vec, tf.TensorSpec([cfg.epochs, t * n], tf.int32)])
+
+    # ----------------------------------------------------------------- acting
+    def policy_and_values(self, obs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(pi(.|s) [B, A], V(s) [B]) for a batch of frame stacks."""
+        logits, values = self._forward(np.asarray(obs, np.uint8))
+        logits = logits.numpy().astype(np.float64)
+        logits -= logits.max(axis=1, keepdims=True)
+        probs = np.exp(logits)
+        return probs / probs.sum(axis=1, keepdims=True), values.numpy()[:, 0]
+
+    def act(self, obs: np.ndarray, rng: np.random.Generator):
+        """Sampled actions, their log-probabilities and V(s), one per row of ``obs``."""
+        probs, values = self.policy_and_values(obs)
+        cdf = np.cumsum(probs, axis=1)
+        draws = rng.random((len(cdf), 1)) * cdf[:, -1:]
+        actions = np.minimum((draws > cdf).sum(axis=1), self.n_actions - 1)
+        logp = np.log(np.maximum(probs[np.arange(len(actions)), actions], 1e-12))
+        return actions.astype(np.int32), logp.astype(np.float32), values.astype(np.float32)
+
+    def values(self, obs: np.ndarray) -> np.ndarray:
+        return self.policy_and_values(obs)[1]
+
+    def greedy_actions(self, obs: np.ndarray) -> np.ndarray:
+        return self.policy_and_values(obs)[0].argmax(axis=1)
+
+    # --------------------------------------------------------------- learning
+    def _update_graph(self, obs, actions, logp_old, values, next_values, rewards, terminated, dones,
+                      perms):
+        cfg = self.cfg
+        t, n = cfg.n_steps, cfg.num_envs
+        advantages, targets = rollout_targets(rewards, values, next_values, terminated, dones, cfg)
+        size = t * n
+        flat = (tf.reshape(obs, [size, *self.obs_shape]), tf.reshape(actions, [size]),
+                tf.reshape(logp_old, [size]), tf.reshape(advantages, [size]), tf.reshape(targets, [size]))
+        per_epoch = size // cfg.minibatch
+        sums = tf.zeros([len(LOSS_NAMES)])
+        for step in tf.range(cfg.epochs * per_epoch):
+            epoch, k = step // per_epoch, step % per_epoch
+            idx = perms[epoch, k * cfg.minibatch:(k + 1) * cfg.minibatch]
+            mb_obs, mb_act, mb_logp, mb_adv, mb_tgt = (tf.gather(x, idx) for x in flat)
+            with tf.GradientTape() as tape:
+                logits, v = self.model(mb_obs, training=True)
+                losses = ppo_losses(logits, v[:, 0], mb_act, mb_logp, mb_adv, mb_tgt, cfg)
+                total = tf.debugging.check_numerics(losses[0], "PPO loss")
+            grads = tape.gradient(total, self.model.trainable_variables)
+            if cfg.max_grad_norm > 0:
+                grads, _ = tf.clip_by_global_norm(grads, cfg.max_grad_norm)
+            self.opt.apply_gradients(zip(grads, self.model.trainable_variables))
+            sums += tf.stack(losses)
+        return sums / tf.cast(cfg.epochs * per_epoch, tf.float32)
+
+    def update(self, obs, actions, logp_old, values, next_values, rewards, terminated, dones,
+               rng: np.random.Generator) -> dict[str, float]:
+        """One PPO update on a [n_steps, num_envs] rollout; returns the mean minibatch losses."""
+        size = self.cfg.n_steps * self.cfg.num_envs
+        perms = np.stack([rng.permutation(size) for _ in range(self.cfg.epochs)]).astype(np.int32)
+        means = self._update(obs, actions, logp_old, values, next_values, rewards, terminated, dones, perms)
+        return dict(zip(LOSS_NAMES, (float(x) for x in means.numpy())))
+
+    # ------------------------------------------------------------ persistence
+    def save(self, folder: str | Path) -> list[Path]:
+        return [save_keras_model(self.model, Path(folder) / MODEL_FILE)]
+
+    def models(self) -> dict[str, keras.Model]:
+        return {"actor_critic": self.model}
+
+    def optimizers(self) -> dict:
+        return {"adam": self.opt}
+
+    def get_weights(self) -> list[np.ndarray]:
+        return self.model.get_weights()
+
+    def set_weights(self, weights: list[np.ndarray]) -> None:
+        self.model.set_weights(weights)

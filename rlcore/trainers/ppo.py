@@ -1,0 +1,152 @@
+"""Rollout loop for PPO over the env pool: ``n_steps`` x ``num_envs`` transitions, then one update.
+
+Experiments may name an info key that marks success (Mario: ``flag_get``) and one that measures
+progress (Mario: ``x_pos``); the trainer then logs the success of every episode, the share over
+the last ``window`` episodes, and prints one line per rollout with the max and min progress (the
+article's console line).
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import keras
+import numpy as np
+import tensorflow as tf
+from tqdm import tqdm
+
+from rlcore.agents.ppo import LOSS_NAMES, PPOAgent
+from rlcore.checkpoint import load_checkpoint, save_checkpoint
+from rlcore.errors import UserError
+from rlcore.trainers.session import RunSpec, TrainingSession, check_resumable
+from rlcore.vector import EnvPool
+
+
+def _final(infos: dict, key: str, i: int, default=0):
+    """An info value of env ``i`` at the step its episode ended (same-step auto-reset)."""
+    final = infos.get("final_info", {})
+    if key in final and final.get(f"_{key}", np.ones(1, bool))[i]:
+        return final[key][i]
+    return default
+
+
+class Rollout:
+    """Preallocated [T, N] buffers of one rollout (frames stay uint8)."""
+
+    def __init__(self, t: int, n: int, obs_shape: tuple):
+        self.obs = np.zeros((t, n, *obs_shape), np.uint8)
+        self.actions = np.zeros((t, n), np.int32)
+        (self.logp, self.values, self.next_values, self.rewards, self.terminated,
+         self.dones) = (np.zeros((t, n), np.float32) for _ in range(6))
+
+    def close(self, last_values: np.ndarray, truncated_values: dict) -> None:
+        """next_values[t] = values[t + 1]; the last row from ``last_values``; truncated steps from
+        the value of their final observation (``truncated_values[(t, i)]``)."""
+        self.next_values[:-1] = self.values[1:]
+        self.next_values[-1] = last_values
+        for (t, i), v in truncated_values.items():
+            self.next_values[t, i] = v
+
+    def arrays(self):
+        return (self.obs, self.actions, self.logp, self.values, self.next_values, self.rewards,
+                self.terminated, self.dones)
+
+
+def train(spec: RunSpec) -> Path:
+    cfg, exp = spec.config, spec.experiment
+    keras.utils.set_random_seed(spec.seed)
+    if (cfg.n_steps * cfg.num_envs) % cfg.minibatch:
+        raise UserError(f"minibatch {cfg.minibatch} must divide n_steps x num_envs = "
+                        f"{cfg.n_steps * cfg.num_envs}")
+    make_env = exp.env_factory(cfg)
+    envs = EnvPool([make_env] * cfg.num_envs, mode=cfg.vec)
+    obs_shape, n_actions = envs.single_observation_space.shape, int(envs.single_action_space.n)
+    agent = PPOAgent(obs_shape, n_actions, cfg)
+    rng = np.random.default_rng(spec.seed)
+    success_key, progress_key = exp.extra.get("success_key"), exp.extra.get("progress_key")
+
+    state = check_resumable(spec) if spec.resume else None
+    if state is not None:
+        state, _ = load_checkpoint(spec.run_dir / "checkpoint.npz", agent.models(), agent.optimizers())
+        rng.bit_generator.state = state["rng"]
+    session = TrainingSession(spec, state, progress_unit="step")
+    successes = list(state.get("successes", [])) if state else []
+    rollouts = int(state.get("rollouts", 0)) if state else 0
+
+    def checkpoint():
+        save_checkpoint(session.checkpoint_path, agent.models(), agent.optimizers(),
+                        session.state(rng=rng.bit_generator.state, rollouts=rollouts, successes=successes))
+
+    t, n = cfg.n_steps, cfg.num_envs
+    buf = Rollout(t, n, obs_shape)
+    running = np.zeros(n)
+    losses = {name: float("nan") for name in LOSS_NAMES}  # CSV columns exist from the first row
+    # a resumed run starts fresh episodes, reseeded from its episode count
+    obs, _ = envs.reset(seed=[spec.seed * 1000 + session.book.episodes + i for i in range(n)])
+    with envs, session.interruptible():
+        while not session.should_stop() and not _succeeded(successes, cfg):
+            max_x, min_x, ended, flags = -np.inf, np.inf, 0, 0
+            truncated_values = {}
+            for step in range(t):
+                actions, logp, values = agent.act(obs, rng)
+                next_obs, rewards, terminated, truncated, infos = envs.step(actions)
+                done = terminated | truncated
+                buf.obs[step], buf.actions[step], buf.logp[step], buf.values[step] = obs, actions, logp, values
+                buf.rewards[step], buf.terminated[step], buf.dones[step] = rewards, terminated, done
+                session.env_steps += n
+                running += rewards
+                if progress_key:
+                    max_x = max(max_x, float(np.max(infos[progress_key])))
+                for i in np.flatnonzero(truncated & ~terminated):
+                    truncated_values[(step, i)] = float(agent.values(infos["final_obs"][i][None])[0])
+                for i in np.flatnonzero(done):
+                    extra = dict(losses)
+                    if progress_key:
+                        x = float(_final(infos, progress_key, i))
+                        max_x, min_x = max(max_x, x), min(min_x, x)
+                        extra[progress_key] = x
+                    if success_key:
+                        won = bool(_final(infos, success_key, i, False))
+                        successes.append(won)
+                        flags += won
+                        extra["success"] = int(won)
+                        extra["success_share"] = _share(successes, cfg.window)
+                    session.end_episode(running[i], extra)
+                    running[i] = 0.0
+                    ended += 1
+                obs = next_obs
+                session.advance(n)
+            buf.close(agent.values(obs), truncated_values)
+            try:
+                losses = agent.update(*buf.arrays(), rng)
+            except tf.errors.InvalidArgumentError as exc:
+                if "PPO" not in str(exc):
+                    raise
+                raise UserError(f"training diverged: NaN/Inf in the PPO loss at env step {session.env_steps}; "
+                                "lower the learning rate or resume from the last checkpoint") from None
+            rollouts += 1
+            session.tracker.log({"rollout": rollouts, "env_steps": session.env_steps,
+                                 "episodes_ended": ended, "successes": flags,
+                                 f"max_{progress_key or 'x'}": max_x, **losses}, table="rollouts")
+            line = f"rollout {rollouts} | env steps {session.env_steps:,} | episodes {session.book.episodes:,}"
+            if progress_key:
+                line += (f" | max {progress_key} {max_x:.0f} | min {progress_key} "
+                         f"{min_x if np.isfinite(min_x) else float('nan'):.0f}")
+            if success_key:
+                line += f" | {success_key} {flags}/{ended} (last {cfg.window}: {_share(successes, cfg.window):.0%})"
+            tqdm.write(line + f" | loss {losses['loss']:.3f} entropy {losses['entropy']:.2f}")
+            if rollouts % cfg.checkpoint_rollouts == 0:
+                checkpoint()
+    checkpoint()
+    if session.stop_requested:
+        raise session.interrupted()
+    return session.finish(agent.save)
+
+
+def _share(successes: list, window: int) -> float:
+    recent = successes[-window:]
+    return float(np.mean(recent)) if recent else 0.0
+
+
+def _succeeded(successes: list, cfg) -> bool:
+    return (cfg.stop_success_share > 0 and len(successes) >= cfg.window
+            and _share(successes, cfg.window) >= cfg.stop_success_share)
