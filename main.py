@@ -41,8 +41,12 @@ def cmd_list(args) -> int:
             shipped = "no shipped model"
             if (folder / "meta.json").is_file():
                 ev = read_meta(folder).get("evaluation")
-                shipped = (f"shipped: {ev['mean']:.1f} +- {ev['std']:.1f} over {ev['episodes']} episodes"
-                           if ev else "shipped (not evaluated)")
+                if not ev:
+                    shipped = "shipped (not evaluated)"
+                elif "success_share" in ev:
+                    shipped = f"shipped: success in {ev['success_share']:.0%} of {ev['episodes']} episodes"
+                else:
+                    shipped = f"shipped: {ev['mean']:.1f} +- {ev['std']:.1f} over {ev['episodes']} episodes"
             print(f"  {algo:<14} {spec.description:<24} presets: {', '.join(spec.presets):<18} {shipped}")
     return 0
 
@@ -88,8 +92,9 @@ def cmd_train(args) -> int:
     meta = json.loads((model_dir / "meta.json").read_text())
     print(f"trained: {meta['episodes']} episodes, {meta['env_steps']} env steps, "
           f"{meta['wall_seconds']:.0f} s; last-100 average {meta['final_average']:.1f}")
-    if args.final_eval_episodes > 0:
-        meta = _evaluate_into_meta(model_dir, args.final_eval_episodes)
+    episodes = _eval_episodes(spec.experiment, args.final_eval_episodes)
+    if episodes > 0:
+        meta = _evaluate_into_meta(model_dir, episodes)
     print(f"model:   {model_dir}/")
     print(f"plot:    {model_dir / meta['plot']}")
     print(f"metrics: {model_dir / 'metrics.csv'}")
@@ -102,20 +107,54 @@ def cmd_train(args) -> int:
     return 0
 
 
-def _evaluate_into_meta(model_dir: Path, episodes: int) -> dict:
-    from rlcore.atomic import write_json
+def _eval_episodes(exp, requested: int | None) -> int:
+    return exp.extra.get("eval_episodes", 100) if requested is None else requested
+
+
+def _run_evaluation(exp, policy, episodes: int, seed_base: int | None) -> tuple[dict, str]:
+    """Evaluate a loaded policy on unseen seeds: ``(summary for meta.json, one-line report)``.
+
+    Experiments with a success event (Mario's flag) draw actions from pi with a per-episode seed
+    (their greedy play is one deterministic trajectory); the others play greedily.
+    """
+    seed_base = exp.eval_seed_base if seed_base is None else seed_base
+    seeds = f"{seed_base}..{seed_base + episodes - 1}"
+    success_key, progress_key = exp.extra.get("success_key"), exp.extra.get("progress_key")
+    if success_key:
+        from rlcore.evaluation import evaluate_success, summarize_success
+
+        records = evaluate_success(policy.make_env, policy.sample, episodes, seed_base, success_key,
+                                   progress_key)
+        summary = {**summarize_success(records, progress_key), "seeds": seeds,
+                   "policy": "sampled from pi, numpy RNG seeded per episode",
+                   "per_episode": records}
+        line = (f"{success_key} in {sum(r['success'] for r in records)}/{len(records)} episodes "
+                f"({summary['success_share']:.0%}); mean return {summary['mean_return']:.1f}")
+        if progress_key:
+            line += (f"; {progress_key} mean {summary[f'mean_{progress_key}']:.0f}, "
+                     f"max {summary[f'max_{progress_key}']:.0f}")
+        return summary, line + f" (seeds {seeds}, actions sampled from pi)"
     from rlcore.evaluation import evaluate
+
+    returns = evaluate(exp, policy, episodes, seed_base, make_env=policy.make_env)
+    summary = {"episodes": episodes, "mean": round(float(returns.mean()), 2),
+               "std": round(float(returns.std()), 2), "min": round(float(returns.min()), 2),
+               "seeds": seeds, "policy": "greedy"}
+    line = (f"greedy return {returns.mean():.1f} +- {returns.std():.1f} over {len(returns)} episodes "
+            f"(min {returns.min():.1f}, max {returns.max():.1f})")
+    if exp.solved_score is not None:
+        line += f"; solved threshold {exp.solved_score:g}: {'met' if returns.mean() >= exp.solved_score else 'not met'}"
+    return summary, line
+
+
+def _evaluate_into_meta(model_dir: Path, episodes: int, seed_base: int | None = None) -> dict:
+    from rlcore.atomic import write_json
     from rlcore.policies import load_policy
 
     exp, meta, policy = load_policy(model_dir)
-    returns = evaluate(exp, policy, episodes)
-    meta["evaluation"] = {"episodes": episodes, "mean": round(float(returns.mean()), 2),
-                          "std": round(float(returns.std()), 2), "min": round(float(returns.min()), 2),
-                          "seeds": f"{exp.eval_seed_base}..{exp.eval_seed_base + episodes - 1}",
-                          "policy": "greedy"}
+    meta["evaluation"], line = _run_evaluation(exp, policy, episodes, seed_base)
     write_json(model_dir / "meta.json", meta)
-    print(f"greedy evaluation over {episodes} unseen-seed episodes: "
-          f"{returns.mean():.1f} +- {returns.std():.1f} (min {returns.min():.1f})")
+    print(f"evaluation (unseen seeds): {line}")
     return meta
 
 
@@ -137,16 +176,17 @@ def _model_dir(args) -> Path:
 
 
 def cmd_evaluate(args) -> int:
-    from rlcore.evaluation import evaluate
     from rlcore.policies import load_policy
 
     model_dir = _model_dir(args)
     exp, meta, policy = load_policy(model_dir, args.experiment, args.algo)
-    returns = evaluate(exp, policy, args.episodes, args.seed_base)
-    solved = (returns.mean() >= exp.solved_score)
-    print(f"{exp.name} {args.algo} ({model_dir}): greedy return {returns.mean():.1f} +- {returns.std():.1f} "
-          f"over {len(returns)} episodes (min {returns.min():.1f}, max {returns.max():.1f}); "
-          f"solved threshold {exp.solved_score:g}: {'met' if solved else 'not met'}")
+    episodes = _eval_episodes(exp, args.episodes)
+    if args.record:
+        _evaluate_into_meta(model_dir, episodes, args.seed_base)
+        print(f"recorded in {model_dir / 'meta.json'}")
+        return 0
+    _, line = _run_evaluation(exp, policy, episodes, args.seed_base)
+    print(f"{exp.name} {args.algo} ({model_dir}): {line}")
     return 0
 
 
@@ -155,7 +195,9 @@ def _render(model_dir: Path, out: Path, fps: int | None, episodes: int, seed: in
     from rlcore.video import record_video
 
     exp, meta, policy = load_policy(model_dir)
-    result = record_video(exp, policy, out, fps or exp.video_fps, episodes, seed)
+    act = policy.sample if exp.extra.get("success_key") else None  # Mario plays as it was evaluated
+    result = record_video(exp, policy, out, fps or exp.video_fps, episodes, seed,
+                          make_env=policy.make_env, act=act)
     print(f"video:   {out} ({result['frames']} frames at {result['fps']} fps; "
           f"episode returns {', '.join(f'{r:.1f}' for r in result['returns'])})")
 
@@ -199,25 +241,29 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
     train.add_argument("--resume", nargs="?", const="latest", default=None, metavar="RUN_DIR",
                        help="continue a run from its checkpoint (default: the latest run of this algo)")
     train.add_argument("--run-dir", default=None, help="where the run writes (default runs/<name>)")
-    train.add_argument("--final-eval-episodes", type=int, default=100,
-                       help="greedy evaluation episodes after training, on unseen seeds (default 100)")
+    train.add_argument("--final-eval-episodes", type=int, default=None,
+                       help="evaluation episodes after training, on unseen seeds "
+                            "(default 100; Mario 10; 0 = none)")
     train.add_argument("--video", action="store_true", help="also render an MP4 of the trained agent")
     train.add_argument("--publish", action="store_true",
                        help="copy the trained model into saved_networks/EXPERIMENT/ALGO/")
     train.add_argument("--no-progress", action="store_true", help="no progress bar")
     _add_hyperparameters(train, argv)
 
-    for name, text in (("evaluate", "greedy mean +- std of a saved model"),
-                       ("render", "MP4 of a saved model playing greedily")):
+    for name, text in (("evaluate", "greedy mean +- std of a saved model on unseen seeds "
+                                    "(Mario: share of episodes reaching the flag, x position)"),
+                       ("render", "MP4 of a saved model playing (greedily; Mario samples from pi)")):
         p = sub.add_parser(name, help=text, description=text)
         p.add_argument("experiment")
         p.add_argument("algo")
         p.add_argument("--model", default=None,
                        help="model folder (default saved_networks/EXPERIMENT/ALGO)")
         if name == "evaluate":
-            p.add_argument("--episodes", type=int, default=100)
+            p.add_argument("--episodes", type=int, default=None, help="default 100; Mario 10")
             p.add_argument("--seed-base", type=int, default=None,
                            help="episode i uses seed SEED_BASE+i (default: the experiment's unseen range)")
+            p.add_argument("--record", action="store_true",
+                           help="write the result into the model folder's meta.json as its evaluation")
         else:
             p.add_argument("--out", default=None, help="MP4 path (default videos/EXPERIMENT_ALGO.mp4)")
             p.add_argument("--fps", type=int, default=None, help="frames per second (default: experiment's)")

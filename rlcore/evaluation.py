@@ -6,10 +6,11 @@ from tqdm import tqdm
 
 
 def evaluate(experiment, policy, episodes: int = 100, seed_base: int | None = None,
-             max_episode_steps: int | None = None, progress: bool = True) -> np.ndarray:
+             max_episode_steps: int | None = None, progress: bool = True, make_env=None) -> np.ndarray:
     """Play ``episodes`` greedy episodes, episode i seeded ``seed_base + i``; return the returns.
 
-    ``max_episode_steps=None`` keeps the env's registered time limit.
+    ``max_episode_steps=None`` keeps the env's registered time limit; ``make_env()``, when given,
+    builds the env instead (a saved model's own level, say).
 
     All episodes run side by side in an in-process vector env so the policy sees one batch per step.
     """
@@ -17,8 +18,9 @@ def evaluate(experiment, policy, episodes: int = 100, seed_base: int | None = No
 
     seed_base = experiment.eval_seed_base if seed_base is None else seed_base
     width = min(episodes, 20)
+    make_env = make_env or (lambda: experiment.make_env(max_episode_steps=max_episode_steps))
     envs = gym.vector.SyncVectorEnv(
-        [lambda: experiment.make_env(max_episode_steps=max_episode_steps) for _ in range(width)],
+        [make_env for _ in range(width)],
         autoreset_mode=gym.vector.AutoresetMode.SAME_STEP)
     returns, next_seed = [], 0
     obs, _ = envs.reset(seed=[seed_base + i for i in range(width)])
@@ -42,3 +44,50 @@ def evaluate(experiment, policy, episodes: int = 100, seed_base: int | None = No
     bar.close()
     envs.close()
     return np.asarray(returns[:episodes])
+
+
+def evaluate_success(make_env, act, episodes: int, seed_base: int, success_key: str,
+                     progress_key: str | None = None, progress: bool = True,
+                     stop_at_success: bool = False) -> list[dict]:
+    """Play episodes one by one; episode i resets with seed ``seed_base + i`` and draws its actions
+    from ``act(obs_batch, rng)`` with ``rng = default_rng(seed_base + i)``.
+
+    For envs where success is an event (Mario's flag), not a return. Each record holds the
+    return, the length, whether ``info[success_key]`` was true at the end, and
+    ``info[progress_key]`` there.
+    """
+    env = make_env()
+    records = []
+    bar = tqdm(total=episodes, unit="ep", desc="evaluate", disable=None if progress else True, leave=False)
+    try:
+        for i in range(episodes):
+            rng = np.random.default_rng(seed_base + i)
+            obs, info = env.reset(seed=seed_base + i)
+            total, length, done = 0.0, 0, False
+            while not done:
+                obs, reward, terminated, truncated, info = env.step(int(act(obs[None], rng)[0]))
+                total, length, done = total + reward, length + 1, terminated or truncated
+            record = {"seed": seed_base + i, "return": float(total), "length": length,
+                      "success": bool(info.get(success_key, False))}
+            if progress_key:
+                record[progress_key] = float(info.get(progress_key, float("nan")))
+            records.append(record)
+            bar.update(1)
+            if stop_at_success and record["success"]:
+                break
+    finally:
+        bar.close()
+        env.close()
+    return records
+
+
+def summarize_success(records: list[dict], progress_key: str | None = None) -> dict:
+    """Share of successes, mean return (and mean progress) over evaluation records."""
+    out = {"episodes": len(records),
+           "success_share": round(float(np.mean([r["success"] for r in records])), 3),
+           "mean_return": round(float(np.mean([r["return"] for r in records])), 2)}
+    if progress_key:
+        values = [r[progress_key] for r in records]
+        out[f"mean_{progress_key}"] = round(float(np.mean(values)), 1)
+        out[f"max_{progress_key}"] = round(float(np.max(values)), 1)
+    return out

@@ -30,9 +30,13 @@ def save_keras_model(model: keras.Model, path: str | os.PathLike) -> Path:
     return path
 
 
-def load_keras_model(path: str | os.PathLike, obs_dim: int | None = None,
+def load_keras_model(path: str | os.PathLike, obs_shape: int | tuple | None = None,
                      n_outputs: int | None = None) -> keras.Model:
-    """Load a ``.h5`` model; a missing, corrupt or wrong-shaped file raises :class:`UserError`."""
+    """Load a ``.h5`` model; a missing, corrupt or wrong-shaped file raises :class:`UserError`.
+
+    ``obs_shape`` (an int for flat observations) must match the input; ``n_outputs`` the first
+    output (a policy-and-value model is checked on its policy head).
+    """
     path = Path(path)
     if not path.is_file():
         raise UserError(f"model file {path} does not exist; train one first or pass --model")
@@ -43,9 +47,12 @@ def load_keras_model(path: str | os.PathLike, obs_dim: int | None = None,
     except Exception as exc:  # h5py/keras raise many types for truncated or foreign files
         reason = str(exc).splitlines()[0][:160] if str(exc) else type(exc).__name__
         raise UserError(f"cannot load model {path}: the file is damaged or not a Keras .h5 model ({reason})")
-    in_shape, out_shape = tuple(model.input_shape[1:]), tuple(model.output_shape[1:])
-    if obs_dim is not None and in_shape != (obs_dim,):
-        raise UserError(f"model {path} takes input {in_shape}, this environment gives ({obs_dim},): "
+    expected_in = (obs_shape,) if isinstance(obs_shape, int) else obs_shape
+    in_shape = tuple(model.input_shape[1:])
+    first_out = model.output_shape[0] if isinstance(model.output_shape, list) else model.output_shape
+    out_shape = tuple(first_out[1:])
+    if expected_in is not None and in_shape != tuple(expected_in):
+        raise UserError(f"model {path} takes input {in_shape}, this environment gives {tuple(expected_in)}: "
                         "it was trained for another environment")
     if n_outputs is not None and out_shape != (n_outputs,):
         raise UserError(f"model {path} outputs {out_shape}, expected ({n_outputs},): "

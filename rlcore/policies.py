@@ -1,4 +1,4 @@
-"""Rebuild a greedy policy from a saved model folder alone (its ``meta.json`` says what it is)."""
+"""Rebuild a policy from a saved model folder alone (its ``meta.json`` says what it is)."""
 from __future__ import annotations
 
 import json
@@ -8,6 +8,7 @@ import numpy as np
 
 from rlcore.errors import UserError
 from rlcore.experiment import get_experiment
+from rlcore.sampling import sample_categorical, softmax
 
 
 def read_meta(model_dir: str | Path) -> dict:
@@ -22,11 +23,20 @@ def read_meta(model_dir: str | Path) -> dict:
         raise UserError(f"{meta_path} is damaged ({exc.msg} at line {exc.lineno})")
 
 
-def load_policy(model_dir: str | Path, experiment: str | None = None, algo: str | None = None):
-    """Return ``(experiment, meta, policy)``; ``policy(obs_batch) -> actions``.
+def config_from_meta(exp, meta: dict):
+    """The run's hyperparameters, rebuilt as the algorithm's config class."""
+    from rlcore.hparams import from_dict
 
-    ``experiment``/``algo``, when given, must match the folder's meta (a DQN folder cannot be
-    rendered as A2C).
+    return from_dict(type(exp.preset(meta["algo"], None)), meta.get("config", {}))
+
+
+def load_policy(model_dir: str | Path, experiment: str | None = None, algo: str | None = None):
+    """Return ``(experiment, meta, policy)``.
+
+    ``policy(obs_batch) -> greedy actions``; ``policy.sample(obs_batch, rng)`` draws from pi for
+    the policy-gradient kinds; ``policy.make_env()`` builds the env the model was trained on
+    (for Mario, its level and action set). ``experiment``/``algo``, when given, must match the
+    folder's meta (a DQN folder cannot be rendered as A2C).
     """
     meta = read_meta(model_dir)
     for key, wanted in (("experiment", experiment), ("algo", algo)):
@@ -35,29 +45,58 @@ def load_policy(model_dir: str | Path, experiment: str | None = None, algo: str 
                             f"not {experiment} {algo}")
     exp = get_experiment(meta["experiment"])
     spec = exp.algo(meta["algo"])
-    env = exp.make_env()
-    obs_dim, n_actions = env.observation_space.shape[0], int(env.action_space.n)
-    env.close()
     if spec.kind not in POLICY_FILES:
         raise UserError(f"no policy loader for algorithm kind {spec.kind!r}")
-    return exp, meta, GreedyPolicy(Path(model_dir) / POLICY_FILES[spec.kind], obs_dim, n_actions)
+    # the registered episode limit, not the training cap: evaluations are comparable across runs
+    make_env = exp.env_factory(config_from_meta(exp, meta), max_episode_steps=None)
+    env = make_env()
+    obs_shape, n_actions = env.observation_space.shape, int(env.action_space.n)
+    env.close()
+    policy = Policy(Path(model_dir) / POLICY_FILES[spec.kind], obs_shape, n_actions,
+                    logits=spec.kind == "ppo", stochastic=spec.kind in ("a2c", "ppo"))
+    policy.make_env = make_env
+    return exp, meta, policy
 
 
-#: algorithm kind -> the saved network whose argmax is the greedy action
-POLICY_FILES = {"dqn": "q_network.h5", "a2c": "actor.h5"}
+#: algorithm kind -> the saved network whose first output ranks the actions
+POLICY_FILES = {"dqn": "q_network.h5", "a2c": "actor.h5", "ppo": "actor_critic.h5"}
 
 
-class GreedyPolicy:
-    """argmax over a saved model's outputs (Q-values or action probabilities), batched."""
+class Policy:
+    """A saved network as a batched policy: argmax of its first output, or a draw from pi.
 
-    def __init__(self, model_path: Path, obs_dim: int, n_actions: int):
+    ``logits``: the first output is policy logits (PPO) rather than Q-values or probabilities.
+    """
+
+    def __init__(self, model_path: Path, obs_shape: tuple, n_actions: int, logits: bool = False,
+                 stochastic: bool = False):
         import tensorflow as tf
 
         from rlcore.models import load_keras_model
 
-        self.model = load_keras_model(model_path, obs_dim, n_actions)
-        self._greedy = tf.function(lambda obs: tf.argmax(self.model(obs), axis=1, output_type=tf.int32),
-                                   input_signature=[tf.TensorSpec([None, obs_dim], tf.float32)])
+        self.model = load_keras_model(model_path, tuple(obs_shape), n_actions)
+        self.logits, self.stochastic, self.n_actions = logits, stochastic, n_actions
+        dtype = self.model.inputs[0].dtype
+        self.dtype = np.dtype(dtype if isinstance(dtype, str) else dtype.name)
+
+        def first_output(obs):
+            out = self.model(obs)
+            return out[0] if isinstance(out, (list, tuple)) else out
+        self._first = tf.function(first_output, input_signature=[
+            tf.TensorSpec([None, *obs_shape], tf.as_dtype(self.dtype))])
+        self.make_env = None
+
+    def scores(self, obs: np.ndarray) -> np.ndarray:
+        return self._first(np.asarray(obs, self.dtype)).numpy()
 
     def __call__(self, obs: np.ndarray) -> np.ndarray:
-        return self._greedy(np.asarray(obs, np.float32)).numpy()
+        return self.scores(obs).argmax(axis=1).astype(np.int32)
+
+    def probs(self, obs: np.ndarray) -> np.ndarray:
+        out = self.scores(obs)
+        return softmax(out) if self.logits else out / out.sum(axis=1, keepdims=True)
+
+    def sample(self, obs: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        if not self.stochastic:
+            raise UserError("this policy has no action distribution to sample (it is a Q-network)")
+        return sample_categorical(self.probs(obs), rng)

@@ -14,6 +14,7 @@ pool closes the rest: no hang, no process left behind.
 from __future__ import annotations
 
 import multiprocessing
+import time
 import warnings
 from typing import Callable, Sequence
 
@@ -89,16 +90,33 @@ class EnvPool:
 
     def _describe_failure(self, exc: BaseException) -> str:
         processes = getattr(self.envs, "processes", [])
-        dead = [(i, p) for i, p in enumerate(processes) if not p.is_alive()]
+        deadline = time.monotonic() + 2.0  # a broken pipe can be seen before the dead worker is reaped
+        while True:
+            dead = [(i, p) for i, p in enumerate(processes) if not p.is_alive()]
+            if dead or isinstance(exc, multiprocessing.TimeoutError) or time.monotonic() > deadline:
+                break
+            time.sleep(0.02)
         if not dead:
-            return (f"env workers stopped answering ({type(exc).__name__}); "
-                    f"no reply within {self.step_timeout:g} s")
+            if isinstance(exc, multiprocessing.TimeoutError):
+                return f"env workers stopped answering: no reply within {self.step_timeout:g} s"
+            return f"the pipe to the env workers broke ({type(exc).__name__}) though every worker is alive"
         parts = []
         for i, p in dead:
             how = (f"killed by signal {-p.exitcode}" if p.exitcode is not None and p.exitcode < 0
                    else f"exited with code {p.exitcode}")
             parts.append(f"env worker {i} (pid {p.pid}) {how}")
         return "; ".join(parts) + ": the env pool is closed; restart the run (or --resume it)"
+
+    def _terminate_workers(self) -> None:
+        for process in self.envs.processes:
+            if process.is_alive():
+                process.terminate()
+        for pipe in self.envs.parent_pipes:
+            if pipe is not None:
+                pipe.close()
+        for process in self.envs.processes:
+            process.join(timeout=5)
+        self.envs.closed = True  # Gymnasium's __del__ would try to close it again
 
     def worker_pids(self) -> list[int]:
         return [p.pid for p in getattr(self.envs, "processes", [])]
@@ -113,8 +131,8 @@ class EnvPool:
                 warnings.simplefilter("ignore")
                 try:
                     self.envs.close(terminate=terminate, timeout=None if terminate else 10)
-                except Exception:
-                    self.envs.close(terminate=True)
+                except Exception:  # a dead worker's pipe breaks Gymnasium's own close: do it by hand
+                    self._terminate_workers()
         else:
             self.envs.close()
 

@@ -58,3 +58,24 @@ def actor_loss(probs, actions, advantages, entropy_coef):
     ce = np.array([-np.log(probs[i, actions[i]]) for i in range(n)])
     entropy = np.array([-(probs[i] * np.log(probs[i])).sum() for i in range(n)])
     return (ce * advantages).mean() - entropy_coef * entropy.mean(), entropy.mean()
+
+
+def ppo_loss(logits, values, actions, logp_old, advantages, targets, clip, value_coef, entropy_coef,
+             quirks=False):
+    """PPO's clipped surrogate + value MSE - entropy bonus, sample by sample.
+
+    quirks: the article's ratio p / (p_old + 1e-3) and -log(p(a) + 1e-3) in place of the entropy.
+    """
+    n = len(actions)
+    surrogate, value_sq, entropy = np.zeros(n), np.zeros(n), np.zeros(n)
+    for i in range(n):
+        z = logits[i] - logits[i].max()
+        p = np.exp(z) / np.exp(z).sum()
+        p_a, p_old = p[actions[i]], np.exp(logp_old[i])
+        ratio = p_a / (p_old + 1e-3) if quirks else np.exp(np.log(p_a) - logp_old[i])
+        clipped = min(max(ratio, 1 - clip), 1 + clip)
+        surrogate[i] = min(ratio * advantages[i], clipped * advantages[i])
+        value_sq[i] = (values[i] - targets[i]) ** 2
+        entropy[i] = -np.log(p_a + 1e-3) if quirks else -(p * np.log(p)).sum()
+    policy = -surrogate.mean()
+    return policy + value_coef * value_sq.mean() - entropy_coef * entropy.mean(), policy, value_sq.mean(), entropy.mean()

@@ -8,7 +8,7 @@ import dataclasses
 import gymnasium as gym
 import numpy as np
 
-from rlcore.configs import A2CConfig, DQNConfig
+from rlcore.configs import A2CConfig, DQNConfig, PPOConfig
 from rlcore.experiment import AlgoSpec, Experiment
 
 
@@ -61,6 +61,57 @@ EXPERIMENT = Experiment(
 def spec(algo, tmp_path, **overrides):
     from rlcore.trainers.session import RunSpec
 
-    cfg = dataclasses.replace(EXPERIMENT.preset(algo, None), **overrides)
-    return RunSpec(EXPERIMENT, algo, "default", cfg, seed=0, wandb_mode="off", run_dir=tmp_path / algo,
+    experiment = IMAGE_EXPERIMENT if algo == "ppo" else EXPERIMENT
+    cfg = dataclasses.replace(experiment.preset(algo, None), **overrides)
+    return RunSpec(experiment, algo, "default", cfg, seed=0, wandb_mode="off", run_dir=tmp_path / algo,
                    command="pytest", progress=False)
+
+
+class ImageSignEnv(gym.Env):
+    """The sign task seen as a uint8 picture (left half bright when s > 0), for the CNN of PPO.
+
+    ``info["score"]`` counts correct actions; ``info["won"]`` is true once 8 of 10 were right.
+    """
+
+    def __init__(self, max_episode_steps=10, render_mode=None):
+        self.observation_space = gym.spaces.Box(0, 255, (8, 8, 2), np.uint8)
+        self.action_space = gym.spaces.Discrete(2)
+        self.length = max_episode_steps or 10
+        self.render_mode = render_mode
+
+    def _obs(self):
+        obs = np.zeros((8, 8, 2), np.uint8)
+        obs[:, :4 if self.sign > 0 else 8, 0] = 255
+        return obs
+
+    def _info(self):
+        return {"score": self.score, "won": self.score >= 8}
+
+    def reset(self, *, seed=None, options=None):
+        super().reset(seed=seed)
+        self.t, self.score = 0, 0
+        self.sign = self.np_random.choice([-1.0, 1.0])
+        return self._obs(), self._info()
+
+    def step(self, action):
+        reward = float((action == 1) == (self.sign > 0))
+        self.t, self.score = self.t + 1, self.score + int(reward)
+        self.sign = self.np_random.choice([-1.0, 1.0])
+        return self._obs(), reward, self.t >= self.length, False, self._info()
+
+    def render(self):
+        return np.repeat(self._obs()[:, :, :1], 3, axis=2)
+
+
+def make_image_env(render_mode=None, max_episode_steps=10):
+    return ImageSignEnv(max_episode_steps, render_mode)
+
+
+PPO = PPOConfig(num_envs=2, vec="inline", n_steps=16, epochs=4, minibatch=16, lr=1e-3, gamma=0.5,
+                gae_lambda=0.9, entropy_coef=0.0, max_episodes=600, max_episode_steps=0,
+                stop_score=1e9, window=10, checkpoint_rollouts=4, stop_success_share=0.9)
+
+IMAGE_EXPERIMENT = Experiment(
+    name="toy_image", description="sign bandit as pictures", make_env=make_image_env, solved_score=None,
+    algos={"ppo": AlgoSpec("ppo", "ppo", "PPO", {"default": PPO})},
+    eval_seed_base=10_000, extra={"success_key": "won", "progress_key": "score", "eval_episodes": 10})

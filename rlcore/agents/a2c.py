@@ -21,6 +21,7 @@ from keras import layers
 from rlcore.agents.advantages import gae
 from rlcore.configs import A2CConfig
 from rlcore.models import numpy_relu_trunk, save_keras_model
+from rlcore.sampling import sample_categorical
 
 _PROB_FLOOR = 1e-8  # keeps log(p) finite when the softmax saturates
 
@@ -118,9 +119,7 @@ class A2CAgent:
 
     def act(self, obs: np.ndarray, rng: np.random.Generator) -> np.ndarray:
         """Sample one action per row of ``obs``."""
-        cdf = np.cumsum(self.probs(obs), axis=1)
-        draws = rng.random((len(cdf), 1)) * cdf[:, -1:]
-        return np.minimum((draws > cdf).sum(axis=1), self.n_actions - 1).astype(np.int32)
+        return sample_categorical(self.probs(obs), rng)
 
     def greedy_actions(self, obs: np.ndarray) -> np.ndarray:
         """argmax_a pi(a|s) for a batch of observations."""

@@ -28,6 +28,7 @@ from keras import layers
 from rlcore.agents.advantages import gae
 from rlcore.configs import PPOConfig
 from rlcore.models import save_keras_model
+from rlcore.sampling import sample_categorical, softmax
 
 MODEL_FILE = "actor_critic.h5"
 _QUIRK_EPS = 1e-3  # the article's constant in pi / (pi_old + 1e-3) and log(pi + 1e-3)
@@ -103,19 +104,14 @@ class PPOAgent:
     def policy_and_values(self, obs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(pi(.|s) [B, A], V(s) [B]) for a batch of frame stacks."""
         logits, values = self._forward(np.asarray(obs, np.uint8))
-        logits = logits.numpy().astype(np.float64)
-        logits -= logits.max(axis=1, keepdims=True)
-        probs = np.exp(logits)
-        return probs / probs.sum(axis=1, keepdims=True), values.numpy()[:, 0]
+        return softmax(logits.numpy()), values.numpy()[:, 0]
 
     def act(self, obs: np.ndarray, rng: np.random.Generator):
         """Sampled actions, their log-probabilities and V(s), one per row of ``obs``."""
         probs, values = self.policy_and_values(obs)
-        cdf = np.cumsum(probs, axis=1)
-        draws = rng.random((len(cdf), 1)) * cdf[:, -1:]
-        actions = np.minimum((draws > cdf).sum(axis=1), self.n_actions - 1)
+        actions = sample_categorical(probs, rng)
         logp = np.log(np.maximum(probs[np.arange(len(actions)), actions], 1e-12))
-        return actions.astype(np.int32), logp.astype(np.float32), values.astype(np.float32)
+        return actions, logp.astype(np.float32), values.astype(np.float32)
 
     def values(self, obs: np.ndarray) -> np.ndarray:
         return self.policy_and_values(obs)[1]

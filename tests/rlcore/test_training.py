@@ -11,15 +11,17 @@ from rlcore.evaluation import evaluate
 from rlcore.policies import load_policy
 from rlcore.trainers import a2c as a2c_trainer
 from rlcore.trainers import dqn as dqn_trainer
+from rlcore.trainers import ppo as ppo_trainer
 from rlcore.trainers.session import Interrupted, check_resumable
 from tests import toy
 
-TRAINERS = {"dqn": dqn_trainer, "a2c": a2c_trainer}
+TRAINERS = {"dqn": dqn_trainer, "a2c": a2c_trainer, "ppo": ppo_trainer}
 
 
 @pytest.fixture(autouse=True)
 def register_toy(monkeypatch):
     monkeypatch.setitem(registry.EXPERIMENT_MODULES, "toy", "tests.toy")
+    monkeypatch.setitem(registry.EXPERIMENT_MODULES, "toy_image", "tests.toy_image")
 
 
 @pytest.mark.parametrize("algo", ["dqn", "a2c"])
@@ -35,9 +37,26 @@ def test_learns_the_toy_task(algo, tmp_path):
     assert len(csv_lines) == meta["episodes"] + 1
 
 
-@pytest.mark.parametrize("algo", ["dqn", "a2c"])
+def test_ppo_learns_the_picture_task_and_stops_on_the_success_share(tmp_path):
+    from rlcore.evaluation import evaluate_success, summarize_success
+
+    model_dir = ppo_trainer.train(toy.spec("ppo", tmp_path))
+    meta = json.loads((model_dir / "meta.json").read_text())
+    assert meta["episodes"] < 600, "stopped by the budget, not by the success share"
+    rollouts = (tmp_path / "ppo" / "rollouts.csv").read_text().splitlines()
+    assert rollouts[0].startswith("rollout,env_steps,episodes_ended,successes,max_score,loss,policy_loss")
+    metrics = (model_dir / "metrics.csv").read_text().splitlines()
+    assert "success_share" in metrics[0] and len(metrics) == meta["episodes"] + 1
+    exp, _, policy = load_policy(model_dir)
+    records = evaluate_success(policy.make_env, policy.sample, 10, 10_000, "won", "score", progress=False)
+    assert summarize_success(records, "score")["success_share"] >= 0.8
+    assert (policy(np.asarray([policy.make_env().reset(seed=1)[0]])) >= 0).all()
+
+
+@pytest.mark.parametrize("algo", ["dqn", "a2c", "ppo"])
 def test_interrupt_then_resume_continues_the_counters(algo, tmp_path):
-    spec = toy.spec(algo, tmp_path, stop_score=99.0, max_episodes=30)
+    spec = toy.spec(algo, tmp_path, stop_score=99.0, max_episodes=30, **(
+        {"stop_success_share": 0.0} if algo == "ppo" else {}))
     # Stop the run as Ctrl-C would, after 12 episodes.
     from rlcore.trainers import session as session_mod
     original = session_mod.TrainingSession.end_episode

@@ -1,0 +1,96 @@
+"""The Mario wrappers on the real NES emulator: frames, stacking, the classic reward and the shaping."""
+import numpy as np
+import pytest
+
+from mario_ppo.env import FRAME_SIZE, classic_reward, gray_84, make_env
+from rlcore.errors import UserError
+
+RIGHT = 1  # SIMPLE_MOVEMENT[1] == ['right']
+
+
+@pytest.fixture(scope="module")
+def env():
+    env = make_env()
+    yield env
+    env.close()
+
+
+def test_observation_is_four_gray_uint8_frames(env):
+    obs, info = env.reset(seed=0)
+    assert obs.shape == (FRAME_SIZE, FRAME_SIZE, 4) and obs.dtype == np.uint8
+    assert env.observation_space.contains(obs)
+    assert (obs[:, :, :1] == obs).all()  # reset shows the first frame four times
+    assert info["x_pos"] == 40 and info["flag_get"] is False
+    assert env.action_space.n == 7
+
+
+def test_step_stacks_the_four_skipped_frames_in_order(env):
+    """Replaying the same actions frame by frame on a second emulator gives the same four frames."""
+    import gymnasium as gym
+    import gym_super_mario_bros  # noqa: F401
+    from gym_super_mario_bros.actions import SIMPLE_MOVEMENT
+    from nes_py.wrappers import JoypadSpace
+
+    raw = JoypadSpace(gym.make("SuperMarioBros-1-1-v0").unwrapped, SIMPLE_MOVEMENT)
+    raw.reset(seed=0)
+    env.reset(seed=0)
+    for _ in range(10):  # walk right for 10 agent steps = 40 frames
+        obs, *_ = env.step(RIGHT)
+        frames = [gray_84(raw.step(RIGHT)[0]) for _ in range(4)]
+    raw.close()
+    for i in range(4):
+        np.testing.assert_array_equal(obs[:, :, i], frames[i])
+    assert not np.array_equal(obs[:, :, 0], obs[:, :, 3])  # Mario moved between them
+
+
+def test_running_right_pays_the_x_gain_over_ten(env):
+    env.reset(seed=0)
+    x_before = 40
+    total = 0.0
+    for _ in range(5):
+        _, reward, terminated, _, info = env.step(RIGHT)
+        total += reward
+        assert not terminated
+    # no death, no clock tick this early: reward = change of x / 10, summed over 4 frames each
+    assert total == pytest.approx((info["x_pos"] - x_before) / 10.0, abs=0.15)
+    assert total > 0
+
+
+def test_death_ends_the_episode_with_the_shaped_penalty(env):
+    """Walking right into the first Goomba kills Mario: -25 in the classic reward, -50 shaping, / 10."""
+    env.reset(seed=0)
+    rewards = []
+    for _ in range(200):
+        _, reward, terminated, truncated, info = env.step(RIGHT)
+        rewards.append(reward)
+        if terminated or truncated:
+            break
+    assert terminated and not truncated and not info["flag_get"]
+    # the last step holds the death: at most (3 frames of +5 x) + (-25) + (-50), then / 10
+    assert rewards[-1] <= (15 - 25 - 50) / 10 + 1e-6
+    assert rewards[-1] >= (-15 * 4 - 50) / 10 - 1e-6
+    assert max(rewards[:-1]) <= 4 * 15 / 10
+
+
+def test_classic_reward_rules():
+    assert classic_reward(103, 100, 400, 400, False) == 3
+    assert classic_reward(200, 100, 400, 400, False) == 0  # a jump of more than 5: a warp, not running
+    assert classic_reward(100, 100, 399, 400, False) == -1  # the clock ticked
+    assert classic_reward(100, 100, 400, 300, False) == 0  # the clock went up: a reset
+    assert classic_reward(104, 100, 399, 400, True) == -15  # 4 - 1 - 25 = -22, clipped to -15
+
+
+def test_unknown_level_and_action_set_are_clear_errors():
+    with pytest.raises(UserError, match="no level 9-1"):
+        make_env(world=9)
+    with pytest.raises(UserError, match="unknown action set 'fancy'"):
+        make_env(actions="fancy")
+
+
+def test_rgb_array_keeps_every_emulator_frame_for_video():
+    env = make_env(render_mode="rgb_array")
+    env.reset(seed=0)
+    env.step(RIGHT)
+    frames = env.get_wrapper_attr("frames")
+    assert len(frames) == 4 and frames[0].shape == (240, 256, 3)
+    env.close()
