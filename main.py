@@ -99,7 +99,7 @@ def cmd_train(args) -> int:
     print(f"plot:    {model_dir / meta['plot']}")
     print(f"metrics: {model_dir / 'metrics.csv'}")
     if args.video:
-        _render(model_dir, model_dir / f"{spec.experiment.name}_{spec.algo}.mp4", None, 1, None)
+        _render(model_dir, model_dir / f"{spec.experiment.name}_{spec.algo}.mp4", None, None, None)
     if args.publish:
         target = shipped_dir(spec.experiment.name, spec.algo)
         _publish(model_dir, target)
@@ -190,11 +190,12 @@ def cmd_evaluate(args) -> int:
     return 0
 
 
-def _render(model_dir: Path, out: Path, fps: int | None, episodes: int, seed: int | None) -> None:
+def _render(model_dir: Path, out: Path, fps: int | None, episodes: int | None, seed: int | None) -> None:
     from rlcore.policies import load_policy
     from rlcore.video import record_video
 
     exp, meta, policy = load_policy(model_dir)
+    episodes = exp.extra.get("episodes_per_video", 1) if episodes is None else episodes
     act = policy.sample if exp.extra.get("success_key") else None  # Mario plays as it was evaluated
     result = record_video(exp, policy, out, fps or exp.video_fps, episodes, seed,
                           make_env=policy.make_env, act=act)
@@ -267,7 +268,7 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
         else:
             p.add_argument("--out", default=None, help="MP4 path (default videos/EXPERIMENT_ALGO.mp4)")
             p.add_argument("--fps", type=int, default=None, help="frames per second (default: experiment's)")
-            p.add_argument("--episodes", type=int, default=1)
+            p.add_argument("--episodes", type=int, default=None, help="default 1; Minitaur 3")
             p.add_argument("--seed", type=int, default=None)
     return parser
 

@@ -102,3 +102,24 @@ class PPOConfig(RunBudget):
     checkpoint_rollouts: int = _h(10, "rollouts between checkpoints")
     stop_success_share: float = _h(0.0, "stop once this share of the last `window` episodes "
                                         "succeeded, e.g. reached the flag (0 = off)")
+
+
+@dataclass(frozen=True)
+class SACConfig(RunBudget):
+    """Soft actor-critic with a tanh-squashed Gaussian actor, twin critics and a learned temperature."""
+    actor_hidden: tuple[int, ...] = _h((256, 256), "actor hidden layer sizes")
+    critic_hidden: tuple[int, ...] = _h((256, 256), "hidden layer sizes of each critic (on state and action)")
+    actor_lr: float = _h(3e-4, "actor learning rate")
+    critic_lr: float = _h(3e-4, "critic learning rate (one Adam over both critics)")
+    alpha_lr: float = _h(3e-4, "temperature learning rate")
+    init_alpha: float = _h(1.0, "initial entropy temperature")
+    target_entropy: float = _h(0.0, "entropy the temperature aims at (0 = -|A|, the default)")
+    gamma: float = _h(0.99, "discount factor")
+    tau: float = _h(0.005, "soft target update rate, every gradient step")
+    batch_size: int = _h(256, "minibatch size")
+    buffer_size: int = _h(1_000_000, "replay memory capacity (transitions)")
+    learning_starts: int = _h(10_000, "initial env steps with uniform random actions, before any update")
+    updates_per_call: int = _h(1, "gradient steps batched into one compiled call, taken every this many "
+                                  "env steps (one env step per gradient step either way)")
+    log_std_min: float = _h(-20.0, "lower clip of the actor's log standard deviation")
+    log_std_max: float = _h(2.0, "upper clip of the actor's log standard deviation")

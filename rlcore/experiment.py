@@ -18,6 +18,7 @@ EXPERIMENT_MODULES = {
     "cartpole": "cartpole.experiment",
     "cartpole_v0": "cartpole.experiment_v0",
     "mario_ppo": "mario_ppo.experiment",
+    "minitaur": "minitaur.experiment",
 }
 
 
@@ -25,7 +26,7 @@ EXPERIMENT_MODULES = {
 class AlgoSpec:
     """One algorithm of an experiment: which trainer runs it and its named presets."""
     name: str
-    kind: str  # trainer / policy family: "dqn" | "a2c" | "ppo"
+    kind: str  # trainer / policy family: "dqn" | "a2c" | "ppo" | "sac"
     description: str
     presets: dict  # preset name -> config dataclass instance
     default_preset: str = "default"

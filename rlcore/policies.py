@@ -50,32 +50,31 @@ def load_policy(model_dir: str | Path, experiment: str | None = None, algo: str 
     # the registered episode limit, not the training cap: evaluations are comparable across runs
     make_env = exp.env_factory(config_from_meta(exp, meta), max_episode_steps=None)
     env = make_env()
-    obs_shape, n_actions = env.observation_space.shape, int(env.action_space.n)
+    obs_shape, action_space = env.observation_space.shape, env.action_space
     env.close()
-    policy = Policy(Path(model_dir) / POLICY_FILES[spec.kind], obs_shape, n_actions,
-                    logits=spec.kind == "ppo", stochastic=spec.kind in ("a2c", "ppo"))
+    path = Path(model_dir) / POLICY_FILES[spec.kind]
+    if spec.kind == "sac":
+        policy = MeanActionPolicy(path, obs_shape, action_space.shape[0])
+    else:
+        policy = Policy(path, obs_shape, int(action_space.n), logits=spec.kind == "ppo",
+                        stochastic=spec.kind in ("a2c", "ppo"))
     policy.make_env = make_env
     return exp, meta, policy
 
 
 #: algorithm kind -> the saved network whose first output ranks the actions
-POLICY_FILES = {"dqn": "q_network.h5", "a2c": "actor.h5", "ppo": "actor_critic.h5"}
+POLICY_FILES = {"dqn": "q_network.h5", "a2c": "actor.h5", "ppo": "actor_critic.h5", "sac": "actor.h5"}
 
 
-class Policy:
-    """A saved network as a batched policy: argmax of its first output, or a draw from pi.
+class _SavedNetwork:
+    """A saved ``.h5`` network behind one compiled call on its first output."""
 
-    ``logits``: the first output is policy logits (PPO) rather than Q-values or probabilities.
-    """
-
-    def __init__(self, model_path: Path, obs_shape: tuple, n_actions: int, logits: bool = False,
-                 stochastic: bool = False):
+    def __init__(self, model_path: Path, obs_shape: tuple, n_outputs: int):
         import tensorflow as tf
 
         from rlcore.models import load_keras_model
 
-        self.model = load_keras_model(model_path, tuple(obs_shape), n_actions)
-        self.logits, self.stochastic, self.n_actions = logits, stochastic, n_actions
+        self.model = load_keras_model(model_path, tuple(obs_shape), n_outputs)
         dtype = self.model.inputs[0].dtype
         self.dtype = np.dtype(dtype if isinstance(dtype, str) else dtype.name)
 
@@ -88,6 +87,29 @@ class Policy:
 
     def scores(self, obs: np.ndarray) -> np.ndarray:
         return self._first(np.asarray(obs, self.dtype)).numpy()
+
+
+class MeanActionPolicy(_SavedNetwork):
+    """SAC's evaluation policy: tanh of the Gaussian mean (the actor outputs mean and log std)."""
+
+    def __init__(self, model_path: Path, obs_shape: tuple, act_dim: int):
+        super().__init__(model_path, obs_shape, 2 * act_dim)
+        self.act_dim = act_dim
+
+    def __call__(self, obs: np.ndarray) -> np.ndarray:
+        return np.tanh(self.scores(obs)[:, :self.act_dim]).astype(np.float32)
+
+
+class Policy(_SavedNetwork):
+    """A saved network as a batched policy: argmax of its first output, or a draw from pi.
+
+    ``logits``: the first output is policy logits (PPO) rather than Q-values or probabilities.
+    """
+
+    def __init__(self, model_path: Path, obs_shape: tuple, n_actions: int, logits: bool = False,
+                 stochastic: bool = False):
+        super().__init__(model_path, obs_shape, n_actions)
+        self.logits, self.stochastic, self.n_actions = logits, stochastic, n_actions
 
     def __call__(self, obs: np.ndarray) -> np.ndarray:
         return self.scores(obs).argmax(axis=1).astype(np.int32)

@@ -79,3 +79,43 @@ def ppo_loss(logits, values, actions, logp_old, advantages, targets, clip, value
         entropy[i] = -np.log(p_a + 1e-3) if quirks else -(p * np.log(p)).sum()
     policy = -surrogate.mean()
     return policy + value_coef * value_sq.mean() - entropy_coef * entropy.mean(), policy, value_sq.mean(), entropy.mean()
+
+
+def mlp(weights, x, final_relu=False):
+    """Dense layers from (kernel, bias) pairs: ReLU between them, linear at the end."""
+    for i in range(0, len(weights), 2):
+        x = x @ weights[i] + weights[i + 1]
+        if i + 2 < len(weights) or final_relu:
+            x = np.maximum(x, 0.0)
+    return x
+
+
+def squashed_gaussian(mean, log_std, noise):
+    """a = tanh(u), u = mean + std * noise; log pi(a) = log N(u) - sum log(1 - tanh(u)^2), naively."""
+    std = np.exp(log_std)
+    u = mean + std * noise
+    log_normal = -0.5 * ((u - mean) / std) ** 2 - np.log(std) - 0.5 * np.log(2 * np.pi)
+    return np.tanh(u), (log_normal - np.log(1.0 - np.tanh(u) ** 2)).sum(axis=1)
+
+
+def sac_policy(actor_w, obs, noise, act_dim, log_std_min=-20.0, log_std_max=2.0):
+    out = mlp(actor_w, obs)
+    return squashed_gaussian(out[:, :act_dim], np.clip(out[:, act_dim:], log_std_min, log_std_max), noise)
+
+
+def q_value(critic_w, obs, action):
+    return mlp(critic_w, np.concatenate([obs, action], axis=1))[:, 0]
+
+
+def sac_critic_target(actor_w, target_ws, alpha, reward, next_obs, terminated, next_noise, gamma, act_dim):
+    next_action, next_logp = sac_policy(actor_w, next_obs, next_noise, act_dim)
+    next_q = np.minimum(*(q_value(w, next_obs, next_action) for w in target_ws))
+    return reward + gamma * (1.0 - terminated) * (next_q - alpha * next_logp)
+
+
+def sac_actor_and_alpha_loss(actor_w, critic_ws, log_alpha, obs, noise, target_entropy, act_dim):
+    action, logp = sac_policy(actor_w, obs, noise, act_dim)
+    q = np.minimum(*(q_value(w, obs, action) for w in critic_ws))
+    actor = np.mean(np.exp(log_alpha) * logp - q)
+    alpha = -np.mean(log_alpha * (logp + target_entropy))
+    return actor, alpha

@@ -8,7 +8,7 @@ import dataclasses
 import gymnasium as gym
 import numpy as np
 
-from rlcore.configs import A2CConfig, DQNConfig, PPOConfig
+from rlcore.configs import A2CConfig, DQNConfig, PPOConfig, SACConfig
 from rlcore.experiment import AlgoSpec, Experiment
 
 
@@ -61,7 +61,7 @@ EXPERIMENT = Experiment(
 def spec(algo, tmp_path, **overrides):
     from rlcore.trainers.session import RunSpec
 
-    experiment = IMAGE_EXPERIMENT if algo == "ppo" else EXPERIMENT
+    experiment = {"ppo": IMAGE_EXPERIMENT, "sac": REACH_EXPERIMENT}.get(algo, EXPERIMENT)
     cfg = dataclasses.replace(experiment.preset(algo, None), **overrides)
     return RunSpec(experiment, algo, "default", cfg, seed=0, wandb_mode="off", run_dir=tmp_path / algo,
                    command="pytest", progress=False)
@@ -115,3 +115,45 @@ IMAGE_EXPERIMENT = Experiment(
     name="toy_image", description="sign bandit as pictures", make_env=make_image_env, solved_score=None,
     algos={"ppo": AlgoSpec("ppo", "ppo", "PPO", {"default": PPO})},
     eval_seed_base=10_000, extra={"success_key": "won", "progress_key": "score", "eval_episodes": 10})
+
+
+class ReachEnv(gym.Env):
+    """Continuous toy: the observation is a target t in [-0.8, 0.8]^2, the reward -|a - t|_1 / 2.
+
+    Ten steps per episode: a random policy scores about -5, a perfect one 0.
+    """
+
+    def __init__(self, max_episode_steps=10, render_mode=None):
+        self.observation_space = gym.spaces.Box(-1.0, 1.0, (2,), np.float32)
+        self.action_space = gym.spaces.Box(-1.0, 1.0, (2,), np.float32)
+        self.length = max_episode_steps or 10
+        self.render_mode = render_mode
+
+    def reset(self, *, seed=None, options=None):
+        super().reset(seed=seed)
+        self.t = 0
+        self.target = self.np_random.uniform(-0.8, 0.8, 2).astype(np.float32)
+        return self.target.copy(), {}
+
+    def step(self, action):
+        reward = -float(np.abs(np.asarray(action) - self.target).sum()) / 2
+        self.t += 1
+        self.target = self.np_random.uniform(-0.8, 0.8, 2).astype(np.float32)
+        return self.target.copy(), reward, False, self.t >= self.length, {}
+
+    def render(self):
+        return np.zeros((32, 32, 3), np.uint8)
+
+
+def make_reach_env(render_mode=None, max_episode_steps=10):
+    return ReachEnv(max_episode_steps, render_mode)
+
+
+SAC = SACConfig(actor_hidden=(32, 32), critic_hidden=(32, 32), actor_lr=3e-3, critic_lr=3e-3, alpha_lr=3e-3,
+                gamma=0.5, batch_size=64, buffer_size=5000, learning_starts=200, updates_per_call=2,
+                max_env_steps=2500, max_episodes=10**6, max_episode_steps=0, stop_score=1e9, window=10,
+                checkpoint_every=50, init_alpha=0.1)
+
+REACH_EXPERIMENT = Experiment(
+    name="toy_reach", description="continuous reach", make_env=make_reach_env, solved_score=-1.0,
+    algos={"sac": AlgoSpec("sac", "sac", "SAC", {"default": SAC})}, eval_seed_base=10_000)

@@ -12,16 +12,18 @@ from rlcore.policies import load_policy
 from rlcore.trainers import a2c as a2c_trainer
 from rlcore.trainers import dqn as dqn_trainer
 from rlcore.trainers import ppo as ppo_trainer
+from rlcore.trainers import sac as sac_trainer
 from rlcore.trainers.session import Interrupted, check_resumable
 from tests import toy
 
-TRAINERS = {"dqn": dqn_trainer, "a2c": a2c_trainer, "ppo": ppo_trainer}
+TRAINERS = {"dqn": dqn_trainer, "a2c": a2c_trainer, "ppo": ppo_trainer, "sac": sac_trainer}
 
 
 @pytest.fixture(autouse=True)
 def register_toy(monkeypatch):
     monkeypatch.setitem(registry.EXPERIMENT_MODULES, "toy", "tests.toy")
     monkeypatch.setitem(registry.EXPERIMENT_MODULES, "toy_image", "tests.toy_image")
+    monkeypatch.setitem(registry.EXPERIMENT_MODULES, "toy_reach", "tests.toy_reach")
 
 
 @pytest.mark.parametrize("algo", ["dqn", "a2c"])
@@ -53,10 +55,18 @@ def test_ppo_learns_the_picture_task_and_stops_on_the_success_share(tmp_path):
     assert (policy(np.asarray([policy.make_env().reset(seed=1)[0]])) >= 0).all()
 
 
-@pytest.mark.parametrize("algo", ["dqn", "a2c", "ppo"])
+def test_sac_learns_the_reach_task(tmp_path):
+    model_dir = sac_trainer.train(toy.spec("sac", tmp_path))
+    exp, meta, policy = load_policy(model_dir)
+    returns = evaluate(exp, policy, episodes=20, progress=False)
+    assert returns.mean() >= -1.0, f"SAC mean-action return {returns.mean():.2f}; random is about -5"
+    assert meta["env_steps"] == 2500
+
+
+@pytest.mark.parametrize("algo", ["dqn", "a2c", "ppo", "sac"])
 def test_interrupt_then_resume_continues_the_counters(algo, tmp_path):
-    spec = toy.spec(algo, tmp_path, stop_score=99.0, max_episodes=30, **(
-        {"stop_success_share": 0.0} if algo == "ppo" else {}))
+    extra = {"ppo": {"stop_success_share": 0.0}, "sac": {"max_env_steps": 0, "learning_starts": 100}}
+    spec = toy.spec(algo, tmp_path, stop_score=99.0, max_episodes=30, **extra.get(algo, {}))
     # Stop the run as Ctrl-C would, after 12 episodes.
     from rlcore.trainers import session as session_mod
     original = session_mod.TrainingSession.end_episode

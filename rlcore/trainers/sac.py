@@ -1,0 +1,94 @@
+"""Step loop for SAC: one env step per gradient step, after ``learning_starts`` random steps.
+
+Like TF-Agents' driver, a time-limit truncation still bootstraps (only ``terminated``, a fall,
+stops it). Checkpoints hold the whole replay memory, so a resumed run continues where it stopped.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import keras
+import numpy as np
+import tensorflow as tf
+
+from rlcore.agents.sac import SACAgent
+from rlcore.checkpoint import load_checkpoint, save_checkpoint
+from rlcore.errors import UserError
+from rlcore.replay import ReplayMemory
+from rlcore.trainers.session import RunSpec, TrainingSession, check_resumable
+
+
+def train(spec: RunSpec) -> Path:
+    cfg = spec.config
+    keras.utils.set_random_seed(spec.seed)
+    env = spec.experiment.make_env(max_episode_steps=cfg.max_episode_steps or None)
+    obs_dim, act_dim = env.observation_space.shape[0], env.action_space.shape[0]
+    agent = SACAgent(obs_dim, act_dim, cfg)
+    memory = ReplayMemory(cfg.buffer_size, (obs_dim,), action_shape=(act_dim,), action_dtype=np.float32)
+    rng = np.random.default_rng(spec.seed)
+
+    state = check_resumable(spec) if spec.resume else None
+    if state is not None:
+        state, arrays = load_checkpoint(spec.run_dir / "checkpoint.npz", agent.models(), agent.optimizers())
+        memory.load_state_dict({k[len("replay/"):]: v for k, v in arrays.items() if k.startswith("replay/")})
+        rng.bit_generator.state = state["rng"]
+        agent.log_alpha.assign(state["log_alpha"])
+        agent.sync_policy_weights()
+    session = TrainingSession(spec, state)
+    if state is not None:
+        session.restore_best_arrays(arrays)
+    grad_steps = int(state["grad_steps"]) if state else 0
+
+    def checkpoint():
+        save_checkpoint(session.checkpoint_path, agent.models(), agent.optimizers(),
+                        session.state(grad_steps=grad_steps, rng=rng.bit_generator.state,
+                                      log_alpha=float(agent.log_alpha.numpy())),
+                        {**{f"replay/{k}": v for k, v in memory.state_dict().items()}, **session.best_arrays()})
+
+    k = cfg.updates_per_call
+    first_seed = spec.seed + session.book.episodes  # a resumed run reseeds from its episode count
+    with session.interruptible():
+        while not session.should_stop():
+            obs, _ = env.reset(seed=first_seed)
+            first_seed = None  # later episodes continue the env's own RNG
+            episode_return, losses = 0.0, []
+            while True:
+                if session.env_steps < cfg.learning_starts:
+                    action = rng.uniform(-1.0, 1.0, act_dim).astype(np.float32)
+                else:
+                    action = agent.act(obs[None], rng)[0]
+                next_obs, reward, terminated, truncated, _ = env.step(action)
+                memory.add(obs, action, reward, next_obs, terminated)
+                session.env_steps += 1
+                episode_return += reward
+                obs = next_obs
+                if session.env_steps >= cfg.learning_starts and session.env_steps % k == 0:
+                    batch = memory.sample(cfg.batch_size * k, rng)
+                    stacked = [x.reshape(k, cfg.batch_size, *x.shape[1:]) for x in batch]
+                    losses.append(_train_steps(agent, stacked, rng, session.env_steps))
+                    grad_steps += k
+                session.maybe_evaluate(agent.greedy_actions, agent.get_weights)
+                if terminated or truncated or session.stop_requested:
+                    break
+            if session.stop_requested:  # partial episode: not counted; its transitions stay in replay
+                break
+            names = ("critic_loss", "actor_loss", "alpha", "entropy", "q_mean")
+            means = {n: float(np.mean([l[n] for l in losses])) if losses else float("nan") for n in names}
+            session.end_episode(episode_return, {"grad_steps": grad_steps, **means})
+            if session.book.episodes % cfg.checkpoint_every == 0:
+                checkpoint()
+    env.close()
+    checkpoint()
+    if session.stop_requested:
+        raise session.interrupted()
+    return session.finish(agent.save, agent.set_weights)
+
+
+def _train_steps(agent: SACAgent, batch, rng, env_steps: int) -> dict:
+    try:
+        return agent.train_steps(*batch, rng)
+    except tf.errors.InvalidArgumentError as exc:
+        if "SAC" in str(exc):
+            raise UserError(f"training diverged: a SAC loss became NaN/Inf at env step {env_steps}; "
+                            "lower the learning rates or resume from the last checkpoint") from None
+        raise
