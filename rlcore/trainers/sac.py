@@ -12,10 +12,10 @@ import numpy as np
 import tensorflow as tf
 
 from rlcore.agents.sac import SACAgent
-from rlcore.checkpoint import load_checkpoint, save_checkpoint
 from rlcore.errors import UserError
 from rlcore.replay import ReplayMemory
-from rlcore.trainers.session import RunSpec, TrainingSession, check_resumable
+from rlcore.trainers import replay_io
+from rlcore.trainers.session import RunSpec, TrainingSession
 
 
 def train(spec: RunSpec) -> Path:
@@ -27,23 +27,17 @@ def train(spec: RunSpec) -> Path:
     memory = ReplayMemory(cfg.buffer_size, (obs_dim,), action_shape=(act_dim,), action_dtype=np.float32)
     rng = np.random.default_rng(spec.seed)
 
-    state = check_resumable(spec) if spec.resume else None
+    state, arrays = replay_io.resume(spec, agent, memory, rng)
     if state is not None:
-        state, arrays = load_checkpoint(spec.run_dir / "checkpoint.npz", agent.models(), agent.optimizers())
-        memory.load_state_dict({k[len("replay/"):]: v for k, v in arrays.items() if k.startswith("replay/")})
-        rng.bit_generator.state = state["rng"]
         agent.log_alpha.assign(state["log_alpha"])
         agent.sync_policy_weights()
     session = TrainingSession(spec, state)
-    if state is not None:
-        session.restore_best_arrays(arrays)
+    session.restore_best_arrays(arrays)
     grad_steps = int(state["grad_steps"]) if state else 0
 
     def checkpoint():
-        save_checkpoint(session.checkpoint_path, agent.models(), agent.optimizers(),
-                        session.state(grad_steps=grad_steps, rng=rng.bit_generator.state,
-                                      log_alpha=float(agent.log_alpha.numpy())),
-                        {**{f"replay/{k}": v for k, v in memory.state_dict().items()}, **session.best_arrays()})
+        replay_io.save(session, agent, memory, rng, grad_steps=grad_steps,
+                       log_alpha=float(agent.log_alpha.numpy()))
 
     k = cfg.updates_per_call
     first_seed = spec.seed + session.book.episodes  # a resumed run reseeds from its episode count
