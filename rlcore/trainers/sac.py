@@ -9,7 +9,6 @@ from pathlib import Path
 
 import keras
 import numpy as np
-import tensorflow as tf
 
 from rlcore.agents.sac import SACAgent
 from rlcore.errors import UserError
@@ -81,8 +80,6 @@ def train(spec: RunSpec) -> Path:
 def _train_steps(agent: SACAgent, batch, rng, env_steps: int) -> dict:
     try:
         return agent.train_steps(*batch, rng)
-    except tf.errors.InvalidArgumentError as exc:
-        if "SAC" in str(exc):
-            raise UserError(f"training diverged: a SAC loss became NaN/Inf at env step {env_steps}; "
-                            "lower the learning rates or resume from the last checkpoint") from None
-        raise
+    except FloatingPointError as exc:
+        raise UserError(f"training diverged: {exc} at env step {env_steps}; "
+                        "lower the learning rates or resume from the last checkpoint") from None

@@ -146,5 +146,5 @@ def test_nan_reward_is_caught():
     agent = SACAgent(OBS, ACT, CFG)
     batch = list(_batch(np.random.default_rng(0)))
     batch[2][:] = np.nan
-    with pytest.raises(tf.errors.InvalidArgumentError, match="SAC critic loss"):
+    with pytest.raises(FloatingPointError, match="SAC critic_loss is NaN"):
         agent.train_steps(*batch, np.random.default_rng(0))
