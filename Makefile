@@ -32,6 +32,8 @@ test-all: $(STAMP)
 benchmark: $(STAMP)
 	$(PY) benchmarks/lunar_lander.py dqn
 	$(PY) benchmarks/cartpole.py --train a2c
+	$(PY) benchmarks/mario.py
+	$(PY) benchmarks/minitaur.py
 
 clean:
 	rm -rf runs wandb videos .pytest_cache

@@ -24,31 +24,45 @@ from rlcore.errors import UserError  # noqa: E402  (TF-free)
 SAVED_NETWORKS = Path("saved_networks")
 
 
-def shipped_dir(experiment: str, algo: str) -> Path:
-    return SAVED_NETWORKS / experiment / algo
+def shipped_dir(experiment: str, algo: str, config=None) -> Path:
+    """saved_networks/EXPERIMENT/ALGO, or for Mario saved_networks/mario_ppo/WORLD-STAGE (one
+    model per level: ``extra["ship_by"]`` names the config fields; without a config, the
+    experiment's ``extra["default_model"]``)."""
+    from rlcore.experiment import get_experiment
+
+    extra = get_experiment(experiment).extra
+    if "ship_by" not in extra:
+        return SAVED_NETWORKS / experiment / algo
+    if config is None:
+        return SAVED_NETWORKS / experiment / extra["default_model"]
+    return SAVED_NETWORKS / experiment / "-".join(str(getattr(config, f)) for f in extra["ship_by"])
 
 
 # ---------------------------------------------------------------- commands
 def cmd_list(args) -> int:
     from rlcore.experiment import experiment_names, get_experiment
-    from rlcore.policies import read_meta
 
     for name in experiment_names():
         exp = get_experiment(name)
         print(f"{name}: {exp.description}")
         for algo, spec in exp.algos.items():
-            folder = shipped_dir(name, algo)
-            shipped = "no shipped model"
-            if (folder / "meta.json").is_file():
-                ev = read_meta(folder).get("evaluation")
-                if not ev:
-                    shipped = "shipped (not evaluated)"
-                elif "success_share" in ev:
-                    shipped = f"shipped: success in {ev['success_share']:.0%} of {ev['episodes']} episodes"
-                else:
-                    shipped = f"shipped: {ev['mean']:.1f} +- {ev['std']:.1f} over {ev['episodes']} episodes"
-            print(f"  {algo:<14} {spec.description:<24} presets: {', '.join(spec.presets):<18} {shipped}")
+            folders = ([shipped_dir(name, algo)] if "ship_by" not in exp.extra
+                       else sorted((SAVED_NETWORKS / name).glob("*-*")))
+            shipped = [_shipped_summary(f) for f in folders if (f / "meta.json").is_file()]
+            print(f"  {algo:<14} {spec.description:<24} presets: {', '.join(spec.presets):<18} "
+                  f"{'; '.join(shipped) or 'no shipped model'}")
     return 0
+
+
+def _shipped_summary(folder: Path) -> str:
+    from rlcore.policies import read_meta
+
+    ev = read_meta(folder).get("evaluation")
+    if not ev:
+        return f"{folder.name}: shipped (not evaluated)"
+    if "success_share" in ev:
+        return f"{folder.name}: success in {ev['success_share']:.0%} of {ev['episodes']} episodes"
+    return f"shipped: {ev['mean']:.1f} +- {ev['std']:.1f} over {ev['episodes']} episodes"
 
 
 def _spec_from_args(args):
@@ -101,7 +115,7 @@ def cmd_train(args) -> int:
     if args.video:
         _render(model_dir, model_dir / f"{spec.experiment.name}_{spec.algo}.mp4", None, None, None)
     if args.publish:
-        target = shipped_dir(spec.experiment.name, spec.algo)
+        target = shipped_dir(spec.experiment.name, spec.algo, spec.config)
         _publish(model_dir, target)
         print(f"published to {target}/")
     return 0

@@ -41,5 +41,6 @@ EXPERIMENT = Experiment(
     algos={"ppo": AlgoSpec("ppo", "ppo", "PPO, 8 envs over Pipes", {"article": ARTICLE, "default": DEFAULT})},
     video_fps=60,
     extra={"env_fields": ("world", "stage", "actions"), "success_key": "flag_get",
-           "progress_key": "x_pos", "eval_episodes": 10, "score_label": "return (shaped, /10)"},
+           "progress_key": "x_pos", "eval_episodes": 10,
+           "ship_by": ("world", "stage"), "default_model": "1-1", "score_label": "return (shaped, /10)"},
 )

@@ -50,7 +50,7 @@ class MinitaurEnv(gym.Env):
     metadata = {"render_modes": ["rgb_array"], "render_fps": 100}
 
     def __init__(self, render_mode: str | None = None, randomize: bool = True,
-                 render_size: tuple[int, int] = (480, 360)):
+                 render_size: tuple[int, int] = (320, 240)):
         import pybullet
         import pybullet_data
         from pybullet_utils import bullet_client

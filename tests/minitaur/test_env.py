@@ -118,7 +118,7 @@ def test_rgb_array_render():
     env = make_env(render_mode="rgb_array")
     env.reset(seed=0)
     frame = env.render()
-    assert frame.shape == (360, 480, 3) and frame.dtype == np.uint8 and frame.std() > 5
+    assert frame.shape == (240, 320, 3) and frame.dtype == np.uint8 and frame.std() > 5
     env.close()
 
 
