@@ -13,30 +13,13 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import shutil
 import sys
 from pathlib import Path
 
 os.environ.setdefault("TF_CPP_MIN_LOG_LEVEL", "2")
 
-from rlcore.errors import UserError  # noqa: E402  (TF-free)
-
-SAVED_NETWORKS = Path("saved_networks")
-
-
-def shipped_dir(experiment: str, algo: str, config=None) -> Path:
-    """saved_networks/EXPERIMENT/ALGO, or for Mario saved_networks/mario_ppo/WORLD-STAGE (one
-    model per level: ``extra["ship_by"]`` names the config fields; without a config, the
-    experiment's ``extra["default_model"]``)."""
-    from rlcore.experiment import get_experiment
-
-    extra = get_experiment(experiment).extra
-    if "ship_by" not in extra:
-        return SAVED_NETWORKS / experiment / algo
-    if config is None:
-        return SAVED_NETWORKS / experiment / extra["default_model"]
-    return SAVED_NETWORKS / experiment / "-".join(str(getattr(config, f)) for f in extra["ship_by"])
-
+from rlcore import shipping  # noqa: E402  (TF-free)
+from rlcore.errors import UserError  # noqa: E402
 
 # ---------------------------------------------------------------- commands
 def cmd_list(args) -> int:
@@ -46,23 +29,12 @@ def cmd_list(args) -> int:
         exp = get_experiment(name)
         print(f"{name}: {exp.description}")
         for algo, spec in exp.algos.items():
-            folders = ([shipped_dir(name, algo)] if "ship_by" not in exp.extra
-                       else sorted((SAVED_NETWORKS / name).glob("*-*")))
-            shipped = [_shipped_summary(f) for f in folders if (f / "meta.json").is_file()]
+            folders = ([shipping.shipped_dir(name, algo)] if "ship_by" not in exp.extra
+                       else sorted((shipping.SAVED_NETWORKS / name).glob("*-*")))
+            shipped = [shipping.shipped_summary(f) for f in folders if (f / "meta.json").is_file()]
             print(f"  {algo:<14} {spec.description:<24} presets: {', '.join(spec.presets):<18} "
                   f"{'; '.join(shipped) or 'no shipped model'}")
     return 0
-
-
-def _shipped_summary(folder: Path) -> str:
-    from rlcore.policies import read_meta
-
-    ev = read_meta(folder).get("evaluation")
-    if not ev:
-        return f"{folder.name}: shipped (not evaluated)"
-    if "success_share" in ev:
-        return f"{folder.name}: success in {ev['success_share']:.0%} of {ev['episodes']} episodes"
-    return f"shipped: {ev['mean']:.1f} +- {ev['std']:.1f} over {ev['episodes']} episodes"
 
 
 def _spec_from_args(args):
@@ -106,87 +78,26 @@ def cmd_train(args) -> int:
     meta = json.loads((model_dir / "meta.json").read_text())
     print(f"trained: {meta['episodes']} episodes, {meta['env_steps']} env steps, "
           f"{meta['wall_seconds']:.0f} s; last-100 average {meta['final_average']:.1f}")
-    episodes = _eval_episodes(spec.experiment, args.final_eval_episodes)
+    episodes = shipping.eval_episodes(spec.experiment, args.final_eval_episodes)
     if episodes > 0:
-        meta = _evaluate_into_meta(model_dir, episodes)
+        meta = shipping.evaluate_into_meta(model_dir, episodes)
     print(f"model:   {model_dir}/")
     print(f"plot:    {model_dir / meta['plot']}")
     print(f"metrics: {model_dir / 'metrics.csv'}")
     if args.video:
         _render(model_dir, model_dir / f"{spec.experiment.name}_{spec.algo}.mp4", None, None, None)
     if args.publish:
-        target = shipped_dir(spec.experiment.name, spec.algo, spec.config)
-        _publish(model_dir, target)
+        target = shipping.shipped_dir(spec.experiment.name, spec.algo, spec.config)
+        shipping.publish(model_dir, target)
         print(f"published to {target}/")
     return 0
-
-
-def _eval_episodes(exp, requested: int | None) -> int:
-    return exp.extra.get("eval_episodes", 100) if requested is None else requested
-
-
-def _run_evaluation(exp, policy, episodes: int, seed_base: int | None) -> tuple[dict, str]:
-    """Evaluate a loaded policy on unseen seeds: ``(summary for meta.json, one-line report)``.
-
-    Experiments with a success event (Mario's flag) draw actions from pi with a per-episode seed
-    (their greedy play is one deterministic trajectory); the others play greedily.
-    """
-    seed_base = exp.eval_seed_base if seed_base is None else seed_base
-    seeds = f"{seed_base}..{seed_base + episodes - 1}"
-    success_key, progress_key = exp.extra.get("success_key"), exp.extra.get("progress_key")
-    if success_key:
-        from rlcore.evaluation import evaluate_success, summarize_success
-
-        records = evaluate_success(policy.make_env, policy.sample, episodes, seed_base, success_key,
-                                   progress_key)
-        summary = {**summarize_success(records, progress_key), "seeds": seeds,
-                   "policy": "sampled from pi, numpy RNG seeded per episode",
-                   "per_episode": records}
-        line = (f"{success_key} in {sum(r['success'] for r in records)}/{len(records)} episodes "
-                f"({summary['success_share']:.0%}); mean return {summary['mean_return']:.1f}")
-        if progress_key:
-            line += (f"; {progress_key} mean {summary[f'mean_{progress_key}']:.0f}, "
-                     f"max {summary[f'max_{progress_key}']:.0f}")
-        return summary, line + f" (seeds {seeds}, actions sampled from pi)"
-    from rlcore.evaluation import evaluate
-
-    returns = evaluate(exp, policy, episodes, seed_base, make_env=policy.make_env)
-    summary = {"episodes": episodes, "mean": round(float(returns.mean()), 2),
-               "std": round(float(returns.std()), 2), "min": round(float(returns.min()), 2),
-               "seeds": seeds, "policy": "greedy"}
-    line = (f"greedy return {returns.mean():.1f} +- {returns.std():.1f} over {len(returns)} episodes "
-            f"(min {returns.min():.1f}, max {returns.max():.1f})")
-    if exp.solved_score is not None:
-        line += f"; solved threshold {exp.solved_score:g}: {'met' if returns.mean() >= exp.solved_score else 'not met'}"
-    return summary, line
-
-
-def _evaluate_into_meta(model_dir: Path, episodes: int, seed_base: int | None = None) -> dict:
-    from rlcore.atomic import write_json
-    from rlcore.policies import load_policy
-
-    exp, meta, policy = load_policy(model_dir)
-    meta["evaluation"], line = _run_evaluation(exp, policy, episodes, seed_base)
-    write_json(model_dir / "meta.json", meta)
-    print(f"evaluation (unseen seeds): {line}")
-    return meta
-
-
-def _publish(model_dir: Path, target: Path) -> None:
-    """Copy a finished model folder into saved_networks/, each file atomically, meta.json last."""
-    from rlcore.atomic import write_atomic
-
-    target.mkdir(parents=True, exist_ok=True)
-    files = sorted(p for p in model_dir.iterdir() if p.is_file() and p.name != "meta.json")
-    for src in files + [model_dir / "meta.json"]:
-        write_atomic(target / src.name, lambda tmp, src=src: shutil.copyfile(src, tmp))
 
 
 def _model_dir(args) -> Path:
     from rlcore.experiment import get_experiment
 
     get_experiment(args.experiment).algo(args.algo)  # unknown names -> clear error
-    return Path(args.model) if args.model else shipped_dir(args.experiment, args.algo)
+    return Path(args.model) if args.model else shipping.shipped_dir(args.experiment, args.algo)
 
 
 def cmd_evaluate(args) -> int:
@@ -194,12 +105,12 @@ def cmd_evaluate(args) -> int:
 
     model_dir = _model_dir(args)
     exp, meta, policy = load_policy(model_dir, args.experiment, args.algo)
-    episodes = _eval_episodes(exp, args.episodes)
+    episodes = shipping.eval_episodes(exp, args.episodes)
     if args.record:
-        _evaluate_into_meta(model_dir, episodes, args.seed_base)
+        shipping.evaluate_into_meta(model_dir, episodes, args.seed_base)
         print(f"recorded in {model_dir / 'meta.json'}")
         return 0
-    _, line = _run_evaluation(exp, policy, episodes, args.seed_base)
+    _, line = shipping.run_evaluation(exp, policy, episodes, args.seed_base)
     print(f"{exp.name} {args.algo} ({model_dir}): {line}")
     return 0
 

@@ -43,6 +43,11 @@ def dqn_model_dir(tmp_path):
     (["train", "lunar_lander", "dqn", "--lr", "fast"], "invalid float value: 'fast'"),
     (["evaluate", "lunar_lander", "dqn", "--model", "/nonexistent/model"], "has no meta.json"),
     (["render", "lunar_lander", "sac"], "unknown algorithm 'sac'"),
+    (["train", "mario_ppo", "ppo", "--world", "9", "--num-envs", "1", "--vec", "inline", "--wandb", "off"],
+     "there is no level 9-1"),
+    (["train", "mario_ppo", "ppo", "--actions", "fancy", "--num-envs", "1", "--vec", "inline",
+      "--wandb", "off"], "unknown action set 'fancy'"),
+    (["evaluate", "mario_ppo", "ppo", "--model", "/nonexistent/1-1"], "has no meta.json"),
 ])
 def test_bad_input_is_one_line_and_exit_2(capsys, argv, message):
     code, out, err = run(capsys, *argv)
@@ -50,6 +55,17 @@ def test_bad_input_is_one_line_and_exit_2(capsys, argv, message):
     assert message in err
     assert len(err.strip().splitlines()) == 1, err
     assert "Traceback" not in err
+
+
+def test_a_model_of_another_environment_is_refused(capsys, tmp_path):
+    """A Minitaur SAC actor (28 inputs) in a folder claiming to be LunarLander A2C."""
+    from rlcore.agents.sac import build_actor
+    from rlcore.models import save_keras_model
+
+    save_keras_model(build_actor(28, 8, (8,)), tmp_path / "actor.h5")
+    (tmp_path / "meta.json").write_text(json.dumps({"experiment": "lunar_lander", "algo": "a2c"}))
+    code, _, err = run(capsys, "evaluate", "lunar_lander", "a2c", "--model", str(tmp_path))
+    assert code == 2 and "it was trained for another environment" in err
 
 
 def test_truncated_model_file(capsys, dqn_model_dir):

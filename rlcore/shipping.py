@@ -1,0 +1,95 @@
+"""Where shipped models live (saved_networks/), how a finished run is published there, and the
+evaluation a model folder records in its meta.json. TensorFlow is imported only to evaluate."""
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+SAVED_NETWORKS = Path("saved_networks")
+
+
+def shipped_dir(experiment: str, algo: str, config=None) -> Path:
+    """saved_networks/EXPERIMENT/ALGO, or for Mario saved_networks/mario_ppo/WORLD-STAGE (one
+    model per level: ``extra["ship_by"]`` names the config fields; without a config, the
+    experiment's ``extra["default_model"]``)."""
+    from rlcore.experiment import get_experiment
+
+    extra = get_experiment(experiment).extra
+    if "ship_by" not in extra:
+        return SAVED_NETWORKS / experiment / algo
+    if config is None:
+        return SAVED_NETWORKS / experiment / extra["default_model"]
+    return SAVED_NETWORKS / experiment / "-".join(str(getattr(config, f)) for f in extra["ship_by"])
+
+
+
+def shipped_summary(folder: Path) -> str:
+    from rlcore.policies import read_meta
+
+    ev = read_meta(folder).get("evaluation")
+    if not ev:
+        return f"{folder.name}: shipped (not evaluated)"
+    if "success_share" in ev:
+        return f"{folder.name}: success in {ev['success_share']:.0%} of {ev['episodes']} episodes"
+    return f"shipped: {ev['mean']:.1f} +- {ev['std']:.1f} over {ev['episodes']} episodes"
+
+
+def eval_episodes(exp, requested: int | None) -> int:
+    return exp.extra.get("eval_episodes", 100) if requested is None else requested
+
+
+def run_evaluation(exp, policy, episodes: int, seed_base: int | None) -> tuple[dict, str]:
+    """Evaluate a loaded policy on unseen seeds: ``(summary for meta.json, one-line report)``.
+
+    Experiments with a success event (Mario's flag) draw actions from pi with a per-episode seed
+    (their greedy play is one deterministic trajectory); the others play greedily.
+    """
+    seed_base = exp.eval_seed_base if seed_base is None else seed_base
+    seeds = f"{seed_base}..{seed_base + episodes - 1}"
+    success_key, progress_key = exp.extra.get("success_key"), exp.extra.get("progress_key")
+    if success_key:
+        from rlcore.evaluation import evaluate_success, summarize_success
+
+        records = evaluate_success(policy.make_env, policy.sample, episodes, seed_base, success_key,
+                                   progress_key)
+        summary = {**summarize_success(records, progress_key), "seeds": seeds,
+                   "policy": "sampled from pi, numpy RNG seeded per episode",
+                   "per_episode": records}
+        line = (f"{success_key} in {sum(r['success'] for r in records)}/{len(records)} episodes "
+                f"({summary['success_share']:.0%}); mean return {summary['mean_return']:.1f}")
+        if progress_key:
+            line += (f"; {progress_key} mean {summary[f'mean_{progress_key}']:.0f}, "
+                     f"max {summary[f'max_{progress_key}']:.0f}")
+        return summary, line + f" (seeds {seeds}, actions sampled from pi)"
+    from rlcore.evaluation import evaluate
+
+    returns = evaluate(exp, policy, episodes, seed_base, make_env=policy.make_env)
+    summary = {"episodes": episodes, "mean": round(float(returns.mean()), 2),
+               "std": round(float(returns.std()), 2), "min": round(float(returns.min()), 2),
+               "seeds": seeds, "policy": "greedy"}
+    line = (f"greedy return {returns.mean():.1f} +- {returns.std():.1f} over {len(returns)} episodes "
+            f"(min {returns.min():.1f}, max {returns.max():.1f})")
+    if exp.solved_score is not None:
+        line += f"; solved threshold {exp.solved_score:g}: {'met' if returns.mean() >= exp.solved_score else 'not met'}"
+    return summary, line
+
+
+def evaluate_into_meta(model_dir: Path, episodes: int, seed_base: int | None = None) -> dict:
+    from rlcore.atomic import write_json
+    from rlcore.policies import load_policy
+
+    exp, meta, policy = load_policy(model_dir)
+    meta["evaluation"], line = run_evaluation(exp, policy, episodes, seed_base)
+    write_json(model_dir / "meta.json", meta)
+    print(f"evaluation (unseen seeds): {line}")
+    return meta
+
+
+def publish(model_dir: Path, target: Path) -> None:
+    """Copy a finished model folder into saved_networks/, each file atomically, meta.json last."""
+    from rlcore.atomic import write_atomic
+
+    target.mkdir(parents=True, exist_ok=True)
+    files = sorted(p for p in model_dir.iterdir() if p.is_file() and p.name != "meta.json")
+    for src in files + [model_dir / "meta.json"]:
+        write_atomic(target / src.name, lambda tmp, src=src: shutil.copyfile(src, tmp))
