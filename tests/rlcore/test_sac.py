@@ -87,6 +87,18 @@ def test_one_update_matches_numpy_step_by_step():
         np.testing.assert_array_equal(w, v)
 
 
+class ScriptedNormal:
+    """Stands in for the RNG: hands out prepared arrays for successive ``standard_normal`` calls."""
+
+    def __init__(self, arrays):
+        self.arrays = list(arrays)
+
+    def standard_normal(self, shape):
+        out = self.arrays.pop(0)
+        assert out.shape == shape
+        return out
+
+
 def test_stacked_updates_equal_sequential_ones():
     tf.keras.utils.set_random_seed(0)
     one = SACAgent(OBS, ACT, CFG)
@@ -95,21 +107,11 @@ def test_stacked_updates_equal_sequential_ones():
         b.set_weights(a.get_weights())
     batches = [_batch(np.random.default_rng(i)) for i in (1, 2)]
     rng = np.random.default_rng(3)
-    for batch in batches:
-        one.train_steps(*batch, rng)
+    next_noise, noise = ([rng.standard_normal((1, 32, ACT)) for _ in batches] for _ in range(2))
+    for i, batch in enumerate(batches):  # each call draws its next-action noise, then its noise
+        one.train_steps(*batch, ScriptedNormal([next_noise[i], noise[i]]))
     stacked = [np.concatenate([b[i] for b in batches]) for i in range(5)]
-    # the stacked call draws all next-noise then all noise: give it the same numbers
-    rng_a, rng_b = np.random.default_rng(3), np.random.default_rng(3)
-    draws = [(rng_a.standard_normal((1, 32, ACT)), rng_a.standard_normal((1, 32, ACT))) for _ in batches]
-
-    class Replay:
-        def standard_normal(self, shape):
-            which = Replay.calls
-            Replay.calls += 1
-            return np.concatenate([d[which] for d in draws])
-    Replay.calls = 0
-    two.train_steps(*stacked, Replay())
-    del rng_b
+    two.train_steps(*stacked, ScriptedNormal([np.concatenate(next_noise), np.concatenate(noise)]))
     for a, b in zip(one.actor.get_weights(), two.actor.get_weights()):
         np.testing.assert_allclose(a, b, rtol=1e-5, atol=1e-6)
 
