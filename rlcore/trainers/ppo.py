@@ -24,7 +24,8 @@ from rlcore.vector import EnvPool
 def _final(infos: dict, key: str, i: int, default=0):
     """An info value of env ``i`` at the step its episode ended (same-step auto-reset)."""
     final = infos.get("final_info", {})
-    if key in final and final.get(f"_{key}", np.ones(1, bool))[i]:
+    mask = final.get(f"_{key}")  # Gymnasium marks which envs carry the key
+    if key in final and (mask is None or mask[i]):
         return final[key][i]
     return default
 
