@@ -104,6 +104,8 @@ class TrainingSession:
         self.best_eval = state.get("best_eval")  # {"mean", "std", "env_steps"} of the best evaluation
         self.best_weights = None  # snapshot of the best evaluation's weights (keep_best)
         self.next_eval_step = int(state.get("next_eval_step", cfg.eval_every_steps))
+        # the command that started the run, then one per resume
+        self.commands = list(state.get("commands", [])) + [spec.command]
         self.tracker = Tracker(self.run_dir, self.run_dir.name, self.describe(), spec.wandb_mode,
                                wandb_id=state.get("wandb_id"))
         # the bar counts episodes (DQN, A2C) or env steps (PPO: long episodes, a step budget)
@@ -182,7 +184,7 @@ class TrainingSession:
         return {**self.describe(), "returns": self.book.returns, "solved_episode": self.book.solved_episode,
                 "env_steps": self.env_steps, "wall_seconds": self.elapsed(),
                 "wandb_id": self.tracker.wandb_id, "best_eval": self.best_eval,
-                "next_eval_step": self.next_eval_step, **extra}
+                "next_eval_step": self.next_eval_step, "commands": self.commands, **extra}
 
     def best_arrays(self) -> dict:
         """The kept best weights, as checkpoint arrays."""
@@ -240,7 +242,8 @@ class TrainingSession:
         for table in ("metrics", "evals"):
             if self.tracker.table_path(table).exists():
                 (model_dir / f"{table}.csv").write_bytes(self.tracker.table_path(table).read_bytes())
-        meta = {**self.describe(), "command": s.command, "env_steps": self.env_steps,
+        meta = {**self.describe(), "command": self.commands[0], "commands": self.commands,
+                "env_steps": self.env_steps,
                 "episodes": self.book.episodes, "wall_seconds": round(self.elapsed(), 1),
                 "solved_episode": self.book.solved_episode,
                 "final_average": round(self.book.average, 2), "model_files": files,

@@ -83,9 +83,10 @@ def test_interrupt_then_resume_continues_the_counters(algo, tmp_path):
         session_mod.TrainingSession.end_episode = original
     state = read_checkpoint_state(spec.run_dir / "checkpoint.npz")
     assert len(state["returns"]) >= 12 and state["env_steps"] > 0
-    spec.resume = True
+    spec.resume, spec.command = True, "pytest --resume"
     model_dir = TRAINERS[algo].train(spec)
     meta = json.loads((model_dir / "meta.json").read_text())
+    assert meta["command"] == "pytest" and meta["commands"] == ["pytest", "pytest --resume"]
     assert meta["episodes"] >= 30
     assert meta["env_steps"] > state["env_steps"]
     episodes = [int(line.split(",")[0]) for line in (model_dir / "metrics.csv").read_text().splitlines()[1:]]
