@@ -41,6 +41,11 @@ class ReplayMemory:
         idx = rng.integers(0, self.size, size=batch_size)
         return tuple(getattr(self, name)[idx] for name in self.FIELDS)
 
+    def sample_stacked(self, k: int, batch_size: int, rng: np.random.Generator) -> list[np.ndarray]:
+        """``k`` minibatches stacked on a leading axis (for K gradient steps in one compiled call);
+        the same draw as one ``sample(k * batch_size)``."""
+        return [x.reshape(k, batch_size, *x.shape[1:]) for x in self.sample(k * batch_size, rng)]
+
     def state_dict(self) -> dict[str, np.ndarray]:
         """Arrays for a checkpoint (only the filled part)."""
         state = {name: getattr(self, name)[: self.size] for name in self.FIELDS}

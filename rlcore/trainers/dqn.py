@@ -57,8 +57,7 @@ def train(spec: RunSpec) -> Path:
                 obs = next_obs
                 if session.env_steps % update_period == 0 and len(memory) >= max(cfg.batch_size,
                                                                                   cfg.learning_starts):
-                    batch = memory.sample(cfg.batch_size * cfg.updates_per_call, rng)
-                    stacked = [x.reshape(cfg.updates_per_call, cfg.batch_size, *x.shape[1:]) for x in batch]
+                    stacked = memory.sample_stacked(cfg.updates_per_call, cfg.batch_size, rng)
                     losses.append(_train_steps(agent, stacked, session.env_steps))
                     grad_steps += cfg.updates_per_call
                 session.maybe_evaluate(agent.greedy_actions, agent.q_network.get_weights)

@@ -56,8 +56,7 @@ def train(spec: RunSpec) -> Path:
                 episode_return += reward
                 obs = next_obs
                 if session.env_steps >= cfg.learning_starts and session.env_steps % k == 0:
-                    batch = memory.sample(cfg.batch_size * k, rng)
-                    stacked = [x.reshape(k, cfg.batch_size, *x.shape[1:]) for x in batch]
+                    stacked = memory.sample_stacked(k, cfg.batch_size, rng)
                     losses.append(_train_steps(agent, stacked, rng, session.env_steps))
                     grad_steps += k
                 session.maybe_evaluate(agent.greedy_actions, agent.get_weights)
