@@ -97,8 +97,10 @@ def train(spec: RunSpec) -> Path:
                 running += rewards
                 if progress_key:
                     max_x = max(max_x, float(np.max(infos[progress_key])))
-                for i in np.flatnonzero(truncated & ~terminated):
-                    truncated_values[(step, i)] = float(agent.values(infos["final_obs"][i][None])[0])
+                cut = np.flatnonzero(truncated & ~terminated)
+                if len(cut):  # one batched call for every env cut by a time limit this step
+                    finals = agent.values(np.stack([infos["final_obs"][i] for i in cut]))
+                    truncated_values.update({(step, i): float(v) for i, v in zip(cut, finals)})
                 for i in np.flatnonzero(done):
                     extra = dict(losses)
                     if progress_key:
