@@ -78,11 +78,17 @@ def check_resumable(spec: RunSpec) -> dict:
 
 
 def package_versions() -> dict:
-    import gymnasium
-    import keras
-    import tensorflow as tf
-    return {"python": platform.python_version(), "tensorflow": tf.__version__, "keras": keras.__version__,
-            "gymnasium": gymnasium.__version__, "numpy": np.__version__}
+    """Versions of Python and of the packages a run's numbers depend on (those installed)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    found = {"python": platform.python_version()}
+    for dist in ("tensorflow", "tensorflow-cpu", "keras", "gymnasium", "numpy", "box2d", "nes-py", "gym-super-mario-bros",
+                 "pybullet"):
+        try:
+            found[dist] = version(dist)
+        except PackageNotFoundError:
+            pass
+    return found
 
 
 class TrainingSession:
