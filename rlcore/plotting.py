@@ -42,6 +42,27 @@ def plot_evaluations(csv_path: str | Path, png_path: str | Path, title: str,
     return _save(fig, ax, title, png_path)
 
 
+def plot_progress(csv_path: str | Path, png_path: str | Path, title: str, progress_key: str,
+                  window: int = 100) -> Path:
+    """Episodes with a goal (Mario's flag): how far each got (``progress_key``, with its moving
+    average) and, on the right axis, the share of the last ``window`` episodes that succeeded."""
+    df = pd.read_csv(csv_path)
+    fig, ax = plt.subplots(figsize=(9, 5))
+    ax.plot(df["episode"], df[progress_key], color="tab:blue", linewidth=1, alpha=0.5, label=progress_key)
+    ax.plot(df["episode"], df[progress_key].rolling(window, min_periods=1).mean(), color="tab:orange",
+            linewidth=2, linestyle="--", label=f"average (last {window})")
+    ax.set_xlabel("episode")
+    ax.set_ylabel(progress_key)
+    if "success_share" in df:
+        share = ax.twinx()
+        share.plot(df["episode"], 100 * df["success_share"], color="tab:green", linewidth=2,
+                   label=f"success share (last {window}), %")
+        share.set_ylim(0, 100)
+        share.set_ylabel("success share, %")
+        share.legend(loc="upper left")
+    return _save(fig, ax, title, png_path)
+
+
 def _save(fig, ax, title, png_path) -> Path:
     ax.set_title(title)
     ax.grid(alpha=0.3)

@@ -49,6 +49,7 @@ def test_ppo_learns_the_picture_task_and_stops_on_the_success_share(tmp_path):
     assert rollouts[0].startswith("rollout,env_steps,episodes_ended,successes,max_score,loss,policy_loss")
     metrics = (model_dir / "metrics.csv").read_text().splitlines()
     assert "success_share" in metrics[0] and len(metrics) == meta["episodes"] + 1
+    assert (model_dir / "toy_image_Progress_ppo.png").stat().st_size > 1000  # progress + success share
     exp, _, policy = load_policy(model_dir)
     records = evaluate_success(policy.make_env, policy.sample, 10, 10_000, "won", "score", progress=False)
     assert summarize_success(records, "score")["success_share"] >= 0.8
