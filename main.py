@@ -137,6 +137,30 @@ def cmd_render(args) -> int:
     return 0
 
 
+def cmd_plot(args) -> int:
+    from rlcore.checkpoint import read_checkpoint_state
+    from rlcore.experiment import get_experiment
+    from rlcore.plotting import plot_run
+    from rlcore.trainers.session import CHECKPOINT_FILE
+
+    run_dir = Path(args.run_dir)
+    if not (run_dir / "metrics.csv").is_file():
+        raise UserError(f"no metrics.csv in {run_dir}; give a run folder such as runs/<name>")
+    if (run_dir / "model" / "meta.json").is_file():
+        about = json.loads((run_dir / "model" / "meta.json").read_text())
+    elif (run_dir / CHECKPOINT_FILE).is_file():
+        about = read_checkpoint_state(run_dir / CHECKPOINT_FILE)
+    else:
+        raise UserError(f"{run_dir} has neither a checkpoint nor a model/meta.json to say what it trained")
+    exp = get_experiment(about["experiment"])
+    title = f"{exp.name} {about['algo']} ({about['preset']} preset, seed {about['seed']})"
+    out_dir = Path(args.out) if args.out else run_dir / "plots"
+    out_dir.mkdir(parents=True, exist_ok=True)
+    for path in plot_run(run_dir, out_dir, exp, about["algo"], title, about["config"].get("window", 100)):
+        print(f"plot:    {path}")
+    return 0
+
+
 # ------------------------------------------------------------------ parser
 class _Parser(argparse.ArgumentParser):
     """argparse that reports a bad command line as one line (and exit status 2)."""
@@ -195,6 +219,12 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
             p.add_argument("--fps", type=int, default=None, help="frames per second (default: experiment's)")
             p.add_argument("--episodes", type=int, default=None, help="default 1; Minitaur 3")
             p.add_argument("--seed", type=int, default=None)
+    plot = sub.add_parser("plot", help="write the training plots of a run folder (running, interrupted "
+                                       "or finished)",
+                          description="Write the training plots of a run folder from its CSV tables: score "
+                                      "per episode, periodic evaluations, Mario's x position and flag share.")
+    plot.add_argument("run_dir", help="a run folder, e.g. runs/mario_ppo__ppo__0__<time>")
+    plot.add_argument("--out", default=None, help="folder for the PNGs (default RUN_DIR/plots)")
     return parser
 
 
@@ -212,7 +242,8 @@ def _add_hyperparameters(train: argparse.ArgumentParser, argv: list[str]) -> Non
     add_arguments(train, get_experiment(names[0]).preset(names[1], preset))
 
 
-COMMANDS = {"list": cmd_list, "train": cmd_train, "evaluate": cmd_evaluate, "render": cmd_render}
+COMMANDS = {"list": cmd_list, "train": cmd_train, "evaluate": cmd_evaluate, "render": cmd_render,
+            "plot": cmd_plot}
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -12,6 +12,28 @@ import pandas as pd  # noqa: E402
 from rlcore.atomic import atomic_path  # noqa: E402
 
 
+def plot_run(run_dir: str | Path, out_dir: str | Path, experiment, algo: str, title: str,
+             window: int = 100) -> list[Path]:
+    """Every plot a run's CSV tables allow, written to ``out_dir``; the first is the score plot.
+
+    Reads ``metrics.csv`` (one row per episode) and, when present, ``evals.csv``; experiments with
+    a goal (``extra["progress_key"]``) also get the progress plot.
+    """
+    run_dir, out_dir = Path(run_dir), Path(out_dir)
+    prefix = experiment.extra.get("plot_prefix", experiment.name)
+    label = experiment.extra.get("score_label", "return")
+    metrics, evals = run_dir / "metrics.csv", run_dir / "evals.csv"
+    out = [plot_episode_scores(metrics, out_dir / f"{prefix}_Train_{algo}.png", title,
+                               experiment.solved_score, label)]
+    if experiment.extra.get("progress_key"):
+        out.append(plot_progress(metrics, out_dir / f"{prefix}_Progress_{algo}.png", title,
+                                 experiment.extra["progress_key"], window))
+    if evals.exists():
+        out.append(plot_evaluations(evals, out_dir / f"{prefix}_Eval_{algo}.png", title,
+                                    experiment.solved_score, label))
+    return out
+
+
 def plot_episode_scores(csv_path: str | Path, png_path: str | Path, title: str,
                         solved_score: float | None = None, score_label: str = "return") -> Path:
     """Score per episode, its moving average and the solved line, as in article 000's figure."""

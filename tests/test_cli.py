@@ -48,6 +48,7 @@ def dqn_model_dir(tmp_path):
     (["train", "mario_ppo", "ppo", "--actions", "fancy", "--num-envs", "1", "--vec", "inline",
       "--wandb", "off"], "unknown action set 'fancy'"),
     (["evaluate", "mario_ppo", "ppo", "--model", "/nonexistent/1-1"], "has no meta.json"),
+    (["plot", "/nonexistent/run"], "no metrics.csv in /nonexistent/run"),
 ])
 def test_bad_input_is_one_line_and_exit_2(capsys, argv, message):
     code, out, err = run(capsys, *argv)
@@ -133,6 +134,24 @@ def test_list_and_help(capsys):
         assert f"  {algo} " in out
     code, out, _ = run(capsys, "train", "lunar_lander", "dueling_ddqn", "--help")
     assert code == 0 and "--tau FLOAT" in out and "--updates-per-call" in out
+
+
+def test_plot_of_an_unfinished_mario_run(capsys, tmp_path):
+    """A run with only a checkpoint and its metrics (training still going) gets its plots."""
+    from rlcore.checkpoint import save_checkpoint
+
+    rows = ["episode,total_points,av_latest_points,target_ave_scores,x_pos,success,success_share"]
+    rows += [f"{i},{i % 7 * 10},{30 + i / 10},0,{300 + 40 * i},{int(i == 20)},{0.05 * (i >= 20)}"
+             for i in range(1, 31)]
+    (tmp_path / "metrics.csv").write_text("\n".join(rows) + "\n")
+    save_checkpoint(tmp_path / "checkpoint.npz", {}, {}, {"experiment": "mario_ppo", "algo": "ppo",
+                                                          "preset": "default", "seed": 0,
+                                                          "config": {"window": 20}})
+    code, out, err = run(capsys, "plot", str(tmp_path))
+    assert code == 0, err
+    written = [line.split()[-1] for line in out.splitlines()]
+    assert [Path(p).name for p in written] == ["mario_ppo_Train_ppo.png", "mario_ppo_Progress_ppo.png"]
+    assert all(Path(p).stat().st_size > 1000 for p in written)
 
 
 def test_ctrl_c_saves_a_checkpoint_and_resume_continues(tmp_path):

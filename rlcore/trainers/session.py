@@ -20,7 +20,7 @@ from rlcore.atomic import write_json
 from rlcore.checkpoint import read_checkpoint_state
 from rlcore.errors import UserError
 from rlcore.hparams import to_dict
-from rlcore.plotting import plot_episode_scores, plot_evaluations, plot_progress
+from rlcore.plotting import plot_run
 from rlcore.tracking import Tracker
 from rlcore.trainers.episodes import EpisodeBook
 
@@ -237,18 +237,8 @@ class TrainingSession:
         model_dir.mkdir(parents=True, exist_ok=True)
         files = [p.name for p in save_models(model_dir)]
         exp, s = self.spec.experiment, self.spec
-        prefix = exp.extra.get("plot_prefix", exp.name)
-        plot_name = f"{prefix}_Train_{s.algo}.png"
         title = f"{exp.name} {s.algo} ({s.preset} preset, seed {s.seed})"
-        label = exp.extra.get("score_label", "return")
-        plot_episode_scores(self.tracker.csv_path, model_dir / plot_name, title, exp.solved_score, label)
-        progress_key = exp.extra.get("progress_key")
-        if progress_key:
-            plot_progress(self.tracker.csv_path, model_dir / f"{prefix}_Progress_{s.algo}.png", title,
-                          progress_key, self.spec.config.window)
-        if self.tracker.table_path("evals").exists():
-            plot_evaluations(self.tracker.table_path("evals"), model_dir / f"{prefix}_Eval_{s.algo}.png",
-                             title, exp.solved_score, label)
+        plot_name = plot_run(self.run_dir, model_dir, exp, s.algo, title, self.spec.config.window)[0].name
         for table in ("metrics", "evals"):
             if self.tracker.table_path(table).exists():
                 (model_dir / f"{table}.csv").write_bytes(self.tracker.table_path(table).read_bytes())
