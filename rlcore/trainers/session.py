@@ -82,8 +82,8 @@ def package_versions() -> dict:
     from importlib.metadata import PackageNotFoundError, version
 
     found = {"python": platform.python_version()}
-    for dist in ("tensorflow", "tensorflow-cpu", "keras", "gymnasium", "numpy", "box2d", "nes-py", "gym-super-mario-bros",
-                 "pybullet"):
+    for dist in ("tensorflow", "tensorflow-cpu", "keras", "gymnasium", "numpy", "box2d", "nes-py",
+                 "gym-super-mario-bros", "pybullet"):
         try:
             found[dist] = version(dist)
         except PackageNotFoundError:
