@@ -28,10 +28,14 @@ ARTICLE = MarioPPOConfig(
     max_episode_steps=0, stop_score=1e9, window=100)
 # Default: the same numbers with the quirks fixed (log-ratio, true entropy, lambda-return value
 # target), gradients clipped at norm 0.5, a 6M-step budget, and a stop once half of the last 100
-# training episodes reached the flag.
+# training episodes reached the flag. The entropy weight is 0.01, not 0.05: the article's "entropy",
+# the mean of -log p(a) over actions drawn from the old policy, has zero expected gradient at the
+# old policy (sum_a p(a) grad log p(a) = grad sum_a p(a) = 0), so it barely regularized; with a
+# true entropy at 0.05 our 1-1 policy stayed at 1.0-1.3 nats (of ln 7 = 1.95) and reached the flag
+# in about 1 % of its episodes over 70 rollouts.
 DEFAULT = dataclasses.replace(
     ARTICLE, value_target="gae", article_quirks=False, max_grad_norm=0.5, max_env_steps=6_000_000,
-    stop_success_share=0.5)
+    stop_success_share=0.5, entropy_coef=0.01)
 
 EXPERIMENT = Experiment(
     name="mario_ppo",
