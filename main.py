@@ -152,11 +152,9 @@ def cmd_plot(args) -> int:
         about = read_checkpoint_state(run_dir / CHECKPOINT_FILE)
     else:
         raise UserError(f"{run_dir} has neither a checkpoint nor a model/meta.json to say what it trained")
-    exp = get_experiment(about["experiment"])
-    title = f"{exp.name} {about['algo']} ({about['preset']} preset, seed {about['seed']})"
     out_dir = Path(args.out) if args.out else run_dir / "plots"
     out_dir.mkdir(parents=True, exist_ok=True)
-    for path in plot_run(run_dir, out_dir, exp, about["algo"], title, about["config"].get("window", 100)):
+    for path in plot_run(run_dir, out_dir, get_experiment(about["experiment"]), about):
         print(f"plot:    {path}")
     return 0
 

@@ -12,14 +12,16 @@ import pandas as pd  # noqa: E402
 from rlcore.atomic import atomic_path  # noqa: E402
 
 
-def plot_run(run_dir: str | Path, out_dir: str | Path, experiment, algo: str, title: str,
-             window: int = 100) -> list[Path]:
+def plot_run(run_dir: str | Path, out_dir: str | Path, experiment, about: dict) -> list[Path]:
     """Every plot a run's CSV tables allow, written to ``out_dir``; the first is the score plot.
 
-    Reads ``metrics.csv`` (one row per episode) and, when present, ``evals.csv``; experiments with
-    a goal (``extra["progress_key"]``) also get the progress plot.
+    ``about`` says what the run trained (``algo``, ``preset``, ``seed``, ``config``), as a checkpoint's
+    state or a ``meta.json`` does. Reads ``metrics.csv`` (one row per episode) and, when present,
+    ``evals.csv``; experiments with a goal (``extra["progress_key"]``) also get the progress plot.
     """
-    run_dir, out_dir = Path(run_dir), Path(out_dir)
+    run_dir, out_dir, algo = Path(run_dir), Path(out_dir), about["algo"]
+    title = f"{experiment.name} {algo} ({about['preset']} preset, seed {about['seed']})"
+    window = about["config"].get("window", 100)
     prefix = experiment.extra.get("plot_prefix", experiment.name)
     label = experiment.extra.get("score_label", "return")
     metrics, evals = run_dir / "metrics.csv", run_dir / "evals.csv"

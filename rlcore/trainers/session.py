@@ -236,9 +236,7 @@ class TrainingSession:
         model_dir = self.run_dir / "model"
         model_dir.mkdir(parents=True, exist_ok=True)
         files = [p.name for p in save_models(model_dir)]
-        exp, s = self.spec.experiment, self.spec
-        title = f"{exp.name} {s.algo} ({s.preset} preset, seed {s.seed})"
-        plot_name = plot_run(self.run_dir, model_dir, exp, s.algo, title, self.spec.config.window)[0].name
+        plot_name = plot_run(self.run_dir, model_dir, self.spec.experiment, self.describe())[0].name
         for table in ("metrics", "evals"):
             if self.tracker.table_path(table).exists():
                 (model_dir / f"{table}.csv").write_bytes(self.tracker.table_path(table).read_bytes())

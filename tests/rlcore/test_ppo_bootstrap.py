@@ -35,8 +35,8 @@ def make_counter_env(render_mode=None, max_episode_steps=None):
 
 
 def test_time_limited_steps_bootstrap_from_the_final_observation(tmp_path, monkeypatch):
-    cfg = dataclasses.replace(PPO, n_steps=12, num_envs=2, max_episode_steps=LIMIT, max_env_steps=24, minibatch=8,
-                              stop_success_share=0.0)
+    cfg = dataclasses.replace(PPO, n_steps=12, num_envs=2, max_episode_steps=LIMIT, max_env_steps=24,
+                              minibatch=8, stop_success_share=0.0)
     exp = Experiment(name="counter", description="step counter", make_env=make_counter_env,
                      solved_score=None, algos={"ppo": AlgoSpec("ppo", "ppo", "PPO", {"default": cfg})})
     # V(s) = the step count the observation shows, so a bootstrap from the reset observation gives 0
