@@ -12,6 +12,7 @@ import os
 import sys
 from pathlib import Path
 
+from rlcore.atomic import write_atomic
 from rlcore.errors import UserError
 
 WANDB_MODES = ("auto", "online", "offline", "off")
@@ -75,6 +76,30 @@ class Tracker:
             reason = str(exc).splitlines()[0][:200] if str(exc) else type(exc).__name__
             raise UserError(f"wandb could not start in {mode} mode ({reason}); "
                             "use --wandb offline (sync later with `wandb sync`) or --wandb off")
+
+    def drop_rows_after(self, env_steps: int) -> dict[str, int]:
+        """Remove the rows logged after a checkpoint taken at ``env_steps``.
+
+        A run killed between two checkpoints has logged episodes its checkpoint does not hold;
+        the resumed run plays them again, so their first rows go. Every CSV table of the run with an
+        ``env_steps`` column is rewritten atomically. Returns {file name: rows dropped}.
+        """
+        dropped = {}
+        for path in sorted(self.run_dir.glob("*.csv")):
+            with open(path, newline="") as f:
+                rows = list(csv.reader(f))
+            if not rows or "env_steps" not in rows[0]:
+                continue
+            col = rows[0].index("env_steps")
+            kept = [rows[0]] + [r for r in rows[1:] if len(r) > col and float(r[col]) <= env_steps]
+            if len(kept) < len(rows):
+                dropped[path.name] = len(rows) - len(kept)
+
+                def write(tmp: Path, kept=kept) -> None:
+                    with open(tmp, "w", newline="") as f:
+                        csv.writer(f).writerows(kept)
+                write_atomic(path, write)
+        return dropped
 
     def table_path(self, table: str) -> Path:
         return self.run_dir / f"{table}.csv"

@@ -114,6 +114,11 @@ class TrainingSession:
         self.commands = list(state.get("commands", [])) + [spec.command]
         self.tracker = Tracker(self.run_dir, self.run_dir.name, self.describe(), spec.wandb_mode,
                                wandb_id=state.get("wandb_id"))
+        if resumed_state:
+            dropped = self.tracker.drop_rows_after(self.env_steps)
+            if dropped:
+                print("resume: dropped rows logged after the checkpoint ("
+                      + ", ".join(f"{n} from {name}" for name, n in dropped.items()) + ")", file=sys.stderr)
         # the bar counts episodes (DQN, A2C) or env steps (PPO: long episodes, a step budget)
         self.progress_unit = progress_unit
         by_steps = progress_unit == "step"

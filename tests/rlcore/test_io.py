@@ -134,3 +134,17 @@ def _has_pyav():
 def test_config_dataclasses_are_frozen():
     with pytest.raises(dataclasses.FrozenInstanceError):
         DQNConfig().lr = 1.0
+
+
+def test_tracker_drops_rows_logged_after_a_checkpoint(tmp_path):
+    tracker = Tracker(tmp_path, "test-run", {}, wandb_mode="off")
+    for step in (10, 20, 30, 40):
+        tracker.log({"episode": step // 10, "env_steps": step})
+        tracker.log({"rollout": step // 10, "env_steps": step}, table="rollouts")
+    tracker.close()
+    (tmp_path / "notes.csv").write_text("a,b\n1,2\n")
+    assert tracker.drop_rows_after(20) == {"metrics.csv": 2, "rollouts.csv": 2}
+    assert (tmp_path / "metrics.csv").read_text().splitlines() == ["episode,env_steps", "1,10", "2,20"]
+    assert (tmp_path / "rollouts.csv").read_text().splitlines()[-1] == "2,20"
+    assert (tmp_path / "notes.csv").read_text() == "a,b\n1,2\n"
+    assert tracker.drop_rows_after(20) == {}

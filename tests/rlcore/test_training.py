@@ -1,4 +1,5 @@
 """The real training loops on a tiny env: they learn, checkpoint, resume and write their outputs."""
+import csv
 import json
 
 import numpy as np
@@ -84,6 +85,8 @@ def test_interrupt_then_resume_continues_the_counters(algo, tmp_path):
         session_mod.TrainingSession.end_episode = original
     state = read_checkpoint_state(spec.run_dir / "checkpoint.npz")
     assert len(state["returns"]) >= 12 and state["env_steps"] > 0
+    # A crash after the checkpoint leaves rows the checkpoint does not know; resume must drop them.
+    _append_rows_after_checkpoint(spec.run_dir / "metrics.csv", count=2)
     spec.resume, spec.command = True, "pytest --resume"
     model_dir = TRAINERS[algo].train(spec)
     meta = json.loads((model_dir / "meta.json").read_text())
@@ -92,6 +95,19 @@ def test_interrupt_then_resume_continues_the_counters(algo, tmp_path):
     assert meta["env_steps"] > state["env_steps"]
     episodes = [int(line.split(",")[0]) for line in (model_dir / "metrics.csv").read_text().splitlines()[1:]]
     assert episodes == list(range(1, len(episodes) + 1)), "episode counter restarted or skipped"
+
+
+def _append_rows_after_checkpoint(csv_path, count):
+    """Copy the last row ``count`` times with later episode numbers and env steps."""
+    with open(csv_path, newline="") as f:
+        rows = list(csv.reader(f))
+    header, last = rows[0], rows[-1]
+    ep, steps = header.index("episode"), header.index("env_steps")
+    with open(csv_path, "a", newline="") as f:
+        for k in range(1, count + 1):
+            row = list(last)
+            row[ep], row[steps] = str(int(last[ep]) + k), str(int(float(last[steps])) + 10 * k)
+            csv.writer(f).writerow(row)
 
 
 def test_resume_refuses_a_checkpoint_of_another_algorithm(tmp_path):
