@@ -12,7 +12,7 @@ import os
 import sys
 from pathlib import Path
 
-from rlcore.atomic import write_atomic
+from rlcore.atomic import atomic_path
 from rlcore.errors import UserError
 
 WANDB_MODES = ("auto", "online", "offline", "off")
@@ -94,11 +94,8 @@ class Tracker:
             kept = [rows[0]] + [r for r in rows[1:] if len(r) > col and float(r[col]) <= env_steps]
             if len(kept) < len(rows):
                 dropped[path.name] = len(rows) - len(kept)
-
-                def write(tmp: Path, kept=kept) -> None:
-                    with open(tmp, "w", newline="") as f:
-                        csv.writer(f).writerows(kept)
-                write_atomic(path, write)
+                with atomic_path(path) as tmp, open(tmp, "w", newline="") as f:
+                    csv.writer(f).writerows(kept)
         return dropped
 
     def table_path(self, table: str) -> Path:
