@@ -32,10 +32,14 @@ ARTICLE = MarioPPOConfig(
 # the mean of -log p(a) over actions drawn from the old policy, has zero expected gradient at the
 # old policy (sum_a p(a) grad log p(a) = grad sum_a p(a) = 0), so it barely regularized; with a
 # true entropy at 0.05 our 1-1 policy stayed at 1.0-1.3 nats (of ln 7 = 1.95) and reached the flag
-# in about 1 % of its episodes over 70 rollouts.
+# in about 1 % of its episodes over 70 rollouts. Gamma is 0.9 with lambda 1.0 (Monte-Carlo
+# advantages over a short 10-step horizon): with the article's 0.99 / 0.97 our 1-1 run stalled at
+# x ~2,300 for 70 rollouts and saw no flag after rollout 93, while the same seed at 0.9 / 1.0 was
+# ahead in mean x in every 5-rollout block, reached the flag from rollout 51 and in 41 % of its
+# last 100 training episodes by rollout 123.
 DEFAULT = dataclasses.replace(
     ARTICLE, value_target="gae", article_quirks=False, max_grad_norm=0.5, max_env_steps=6_000_000,
-    stop_success_share=0.5, entropy_coef=0.01)
+    stop_success_share=0.5, entropy_coef=0.01, gamma=0.9, gae_lambda=1.0)
 
 EXPERIMENT = Experiment(
     name="mario_ppo",
