@@ -4,7 +4,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: venv demo test test-all benchmark clean
+.PHONY: venv demo test test-all benchmark save-long-runs clean
 
 # The venv is rebuilt when setup.cfg changes.
 $(STAMP): setup.cfg pyproject.toml
@@ -34,6 +34,11 @@ benchmark: $(STAMP)
 	$(PY) benchmarks/cartpole.py --train a2c
 	$(PY) benchmarks/mario.py
 	$(PY) benchmarks/minitaur.py
+
+# Commit the checkpoints and CSV tables of the runs under long_runs/ (before every stop of a session).
+save-long-runs:
+	git add -A long_runs
+	git diff --cached --quiet -- long_runs || git commit -q -m "long_runs: checkpoints and CSV tables" -- long_runs
 
 clean:
 	rm -rf runs wandb videos .pytest_cache

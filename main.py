@@ -94,10 +94,24 @@ def cmd_train(args) -> int:
 
 
 def _model_dir(args) -> Path:
+    """--model, else the shipped model (for Mario, that of --world/--stage, default 1-1)."""
     from rlcore.experiment import get_experiment
 
-    get_experiment(args.experiment).algo(args.algo)  # unknown names -> clear error
-    return Path(args.model) if args.model else shipping.shipped_dir(args.experiment, args.algo)
+    exp = get_experiment(args.experiment)
+    exp.algo(args.algo)  # unknown names -> clear error
+    level = (args.world, args.stage)
+    if level == (None, None):
+        return Path(args.model) if args.model else shipping.shipped_dir(args.experiment, args.algo)
+    if "ship_by" not in exp.extra:
+        raise UserError(f"--world/--stage choose a Mario level; {exp.name} ships one model per algorithm")
+    if args.model:
+        raise UserError("give either --model or --world/--stage, not both")
+    folder = shipping.SAVED_NETWORKS / exp.name / f"{args.world or 1}-{args.stage or 1}"
+    if not (folder / "meta.json").is_file():
+        shipped = sorted(p.parent.name for p in folder.parent.glob("*-*/meta.json"))
+        raise UserError(f"no shipped model for level {folder.name}; shipped levels: {', '.join(shipped) or 'none'}"
+                        f" (or pass --model RUN_DIR/model)")
+    return folder
 
 
 def cmd_evaluate(args) -> int:
@@ -132,7 +146,8 @@ def cmd_render(args) -> int:
     model_dir = _model_dir(args)
     from rlcore.policies import load_policy
     load_policy(model_dir, args.experiment, args.algo)  # checks before any file is written
-    out = Path(args.out) if args.out else Path("videos") / f"{args.experiment}_{args.algo}.mp4"
+    name = f"{args.experiment}_{args.algo}" + (f"_{model_dir.name}" if args.world or args.stage else "")
+    out = Path(args.out) if args.out else Path("videos") / f"{name}.mp4"
     _render(model_dir, out, args.fps, args.episodes, args.seed)
     return 0
 
@@ -206,6 +221,10 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
         p.add_argument("algo")
         p.add_argument("--model", default=None,
                        help="model folder (default saved_networks/EXPERIMENT/ALGO)")
+        p.add_argument("--world", type=int, default=None, help="Mario: the shipped model of this world "
+                       "(default 1)")
+        p.add_argument("--stage", type=int, default=None, help="Mario: the shipped model of this stage "
+                       "(default 1)")
         if name == "evaluate":
             p.add_argument("--episodes", type=int, default=None, help="default 100; Mario 10")
             p.add_argument("--seed-base", type=int, default=None,

@@ -27,8 +27,12 @@ ARTICLE = MarioPPOConfig(
     value_target="td0", article_quirks=True, max_env_steps=200 * 512 * 8, max_episodes=10**9,
     max_episode_steps=0, stop_score=1e9, window=100)
 # Default: the same numbers with the quirks fixed (log-ratio, true entropy, lambda-return value
-# target), gradients clipped at norm 0.5, a 6M-step budget, and a stop once half of the last 100
-# training episodes reached the flag. The entropy weight is 0.01, not 0.05: the article's "entropy",
+# target), gradients clipped at norm 0.5, a 6M-step budget, and a stop once 80 % of the last 100
+# training episodes reached the flag. Why 80 %: training episodes sample from pi exactly as the
+# 10-episode evaluation does, so the evaluation's flag count is about Binomial(10, share). At 0.5
+# (the first shipped 1-1 run) that meets the 5-of-10 bar only 62 % of the time, and that run got 3;
+# at 0.8 it is 99 %. 1-1's bar of 8 of 10 wants more: at 0.9 it is 93 % (`--stop-success-share 0.9`).
+# The entropy weight is 0.01, not 0.05: the article's "entropy",
 # the mean of -log p(a) over actions drawn from the old policy, has zero expected gradient at the
 # old policy (sum_a p(a) grad log p(a) = grad sum_a p(a) = 0), so it barely regularized; with a
 # true entropy at 0.05 our 1-1 policy stayed at 1.0-1.3 nats (of ln 7 = 1.95) and reached the flag
@@ -36,11 +40,10 @@ ARTICLE = MarioPPOConfig(
 # advantages over a short 10-step horizon): with the article's 0.99 / 0.97 our 1-1 run stalled at
 # x ~2,300 for 70 rollouts and saw no flag after rollout 93, while the same seed at 0.9 / 1.0 was
 # ahead in mean x in all 8 blocks of 10 rollouts up to rollout 80 and reached the flag in 41 % of
-# its last 100 training episodes by rollout 123. The shipped 1-1 model is this preset's seed-0 run
-# (51 % at rollout 158).
+# its last 100 training episodes by rollout 123.
 DEFAULT = dataclasses.replace(
     ARTICLE, value_target="gae", article_quirks=False, max_grad_norm=0.5, max_env_steps=6_000_000,
-    stop_success_share=0.5, entropy_coef=0.01, gamma=0.9, gae_lambda=1.0)
+    stop_success_share=0.8, entropy_coef=0.01, gamma=0.9, gae_lambda=1.0)
 
 EXPERIMENT = Experiment(
     name="mario_ppo",

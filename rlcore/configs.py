@@ -102,6 +102,8 @@ class PPOConfig(RunBudget):
     checkpoint_rollouts: int = _h(10, "rollouts between checkpoints")
     stop_success_share: float = _h(0.0, "stop once this share of the last `window` episodes "
                                         "succeeded, e.g. reached the flag (0 = off)")
+    init_from: str = _h("", "start from the weights of this model folder (e.g. another level's "
+                            "saved_networks/mario_ppo/1-1); empty = random initial weights")
 
 
 @dataclass(frozen=True)

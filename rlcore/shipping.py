@@ -5,7 +5,8 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
-SAVED_NETWORKS = Path("saved_networks")
+#: the repository's saved_networks/, wherever the command is run from
+SAVED_NETWORKS = Path(__file__).resolve().parents[1] / "saved_networks"
 
 
 def shipped_dir(experiment: str, algo: str, config=None) -> Path:

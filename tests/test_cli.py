@@ -49,6 +49,10 @@ def dqn_model_dir(tmp_path):
       "--wandb", "off"], "unknown action set 'fancy'"),
     (["evaluate", "mario_ppo", "ppo", "--model", "/nonexistent/1-1"], "has no meta.json"),
     (["plot", "/nonexistent/run"], "no metrics.csv in /nonexistent/run"),
+    (["evaluate", "mario_ppo", "ppo", "--world", "8", "--stage", "4"], "no shipped model for level 8-4; "
+                                                                        "shipped levels: "),
+    (["render", "lunar_lander", "dqn", "--world", "1"], "--world/--stage choose a Mario level"),
+    (["evaluate", "mario_ppo", "ppo", "--world", "1", "--model", "x"], "either --model or --world/--stage"),
 ])
 def test_bad_input_is_one_line_and_exit_2(capsys, argv, message):
     code, out, err = run(capsys, *argv)
@@ -202,3 +206,19 @@ def test_benchmark_scripts_start(script):
                           capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     assert "JSON" in done.stdout
+
+
+def test_shipped_models_are_found_from_any_working_directory(capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    code, out, _ = run(capsys, "evaluate", "lunar_lander", "dqn", "--episodes", "2")
+    assert code == 0 and "greedy return" in out
+    code, out, _ = run(capsys, "list")
+    assert code == 0 and "1-1: success in" in out and "shipped: " in out
+
+
+def test_evaluate_a_mario_level_by_world_and_stage(capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    code, out, err = run(capsys, "evaluate", "mario_ppo", "ppo", "--world", "1", "--stage", "1",
+                         "--episodes", "1")
+    assert code == 0, err
+    assert f"saved_networks/mario_ppo/1-1): flag_get in " in out

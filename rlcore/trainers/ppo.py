@@ -7,6 +7,7 @@ article's console line).
 """
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import keras
@@ -14,7 +15,8 @@ import numpy as np
 import tensorflow as tf
 from tqdm import tqdm
 
-from rlcore.agents.ppo import LOSS_NAMES, PPOAgent
+from rlcore.agents.ppo import LOSS_NAMES, MODEL_FILE, PPOAgent
+from rlcore.atomic import write_json
 from rlcore.checkpoint import load_checkpoint, save_checkpoint
 from rlcore.errors import UserError
 from rlcore.trainers.session import RunSpec, TrainingSession, check_resumable
@@ -69,13 +71,17 @@ def train(spec: RunSpec) -> Path:
     if state is not None:
         state, _ = load_checkpoint(spec.run_dir / "checkpoint.npz", agent.models(), agent.optimizers())
         rng.bit_generator.state = state["rng"]
+        parent = state.get("init_from")
+    else:
+        parent = init_weights(agent, cfg.init_from, exp.name, spec.algo) if cfg.init_from else None
     session = TrainingSession(spec, state, progress_unit="step")
     successes = list(state.get("successes", [])) if state else []
     rollouts = int(state.get("rollouts", 0)) if state else 0
 
     def checkpoint():
         save_checkpoint(session.checkpoint_path, agent.models(), agent.optimizers(),
-                        session.state(rng=rng.bit_generator.state, rollouts=rollouts, successes=successes))
+                        session.state(rng=rng.bit_generator.state, rollouts=rollouts, successes=successes,
+                                      init_from=parent))
 
     t, n = cfg.n_steps, cfg.num_envs
     buf = Rollout(t, n, obs_shape)
@@ -142,7 +148,27 @@ def train(spec: RunSpec) -> Path:
     checkpoint()
     if session.stop_requested:
         raise session.interrupted()
-    return session.finish(agent.save)
+    model_dir = session.finish(agent.save)
+    if parent:  # the model's story starts with the run whose weights it started from
+        meta = json.loads((model_dir / "meta.json").read_text())
+        write_json(model_dir / "meta.json", {**meta, "init_from": parent})
+    return model_dir
+
+
+def init_weights(agent: PPOAgent, folder: str, experiment: str, algo: str) -> dict:
+    """Load the weights of the model folder ``folder`` (``--init-from``) into ``agent``; return what
+    that model was (its path, training commands, env steps, wall time, evaluation) for meta.json."""
+    from rlcore.models import load_keras_model
+    from rlcore.policies import read_meta
+
+    meta = read_meta(folder)
+    if (meta.get("experiment"), meta.get("algo")) != (experiment, algo):
+        raise UserError(f"--init-from {folder} holds a {meta.get('experiment')} {meta.get('algo')} model, "
+                        f"not {experiment} {algo}")
+    source = load_keras_model(Path(folder) / MODEL_FILE, agent.obs_shape, agent.n_actions)
+    agent.set_weights(source.get_weights())
+    keep = ("config", "commands", "env_steps", "episodes", "wall_seconds", "evaluation", "init_from")
+    return {"path": str(folder), **{k: meta[k] for k in keep if k in meta}}
 
 
 def _share(successes: list, window: int) -> float:

@@ -153,3 +153,29 @@ def test_training_stops_when_an_evaluation_reaches_the_stop_eval_score(tmp_path)
     meta = json.loads((dqn_trainer.train(spec) / "meta.json").read_text())
     assert meta["best_eval"]["mean"] >= 9.0
     assert meta["episodes"] < 200
+
+
+def test_ppo_starts_from_another_models_weights_and_records_it(tmp_path):
+    from rlcore.agents.ppo import PPOAgent
+    from rlcore.models import load_keras_model
+
+    first = ppo_trainer.train(toy.spec("ppo", tmp_path / "a", max_env_steps=64, stop_success_share=0.0))
+    parent = load_keras_model(first / "actor_critic.h5").get_weights()
+    spec = toy.spec("ppo", tmp_path / "b", max_env_steps=64, stop_success_share=0.0, init_from=str(first))
+    agent = PPOAgent((8, 8, 2), 2, spec.config)
+    record = ppo_trainer.init_weights(agent, str(first), "toy_image", "ppo")
+    for got, want in zip(agent.get_weights(), parent):
+        np.testing.assert_array_equal(got, want)
+    assert record["path"] == str(first) and record["env_steps"] == 64
+    meta = json.loads((ppo_trainer.train(spec) / "meta.json").read_text())
+    assert meta["config"]["init_from"] == str(first)
+    assert meta["init_from"]["commands"] == ["pytest"] and meta["init_from"]["env_steps"] == 64
+
+
+def test_init_from_a_model_of_another_experiment_is_refused(tmp_path):
+    first = a2c_trainer.train(toy.spec("a2c", tmp_path / "a", max_episodes=3, stop_score=99.0))
+    spec = toy.spec("ppo", tmp_path / "b", init_from=str(first))
+    with pytest.raises(UserError, match="holds a toy a2c model, not toy_image ppo"):
+        ppo_trainer.train(spec)
+    with pytest.raises(UserError, match="no meta.json"):
+        ppo_trainer.train(toy.spec("ppo", tmp_path / "c", init_from=str(tmp_path)))
