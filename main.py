@@ -19,6 +19,7 @@ from pathlib import Path
 os.environ.setdefault("TF_CPP_MIN_LOG_LEVEL", "2")
 
 from rlcore import shipping  # noqa: E402  (TF-free)
+from rlcore.seeding import MAX_RUN_SEED  # noqa: E402
 from rlcore.errors import UserError  # noqa: E402
 
 # ---------------------------------------------------------------- commands
@@ -182,6 +183,24 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"error: {message} (see `{self.prog} --help`)\n")
 
 
+def _whole_number(low: int, high: int | None = None):
+    """An argparse type: an integer in [low, high], refused with what is allowed."""
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+        if value < low or (high is not None and value > high):
+            allowed = f"from {low} to {high}" if high is not None else f"of at least {low}"
+            raise argparse.ArgumentTypeError(f"{value} is invalid: allowed is a whole number {allowed}")
+        return value
+    return parse
+
+
+COUNT, NON_NEGATIVE = _whole_number(1), _whole_number(0)
+SEED = _whole_number(0, MAX_RUN_SEED)
+
+
 def build_parser(argv: list[str]) -> argparse.ArgumentParser:
     parser = _Parser(
         prog="main.py", description="TensorFlow 2 / Keras deep RL: train, evaluate and render agents.",
@@ -196,15 +215,17 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
     train.add_argument("experiment", help="e.g. lunar_lander")
     train.add_argument("algo", help="e.g. dqn, ddqn, dueling_dqn, dueling_ddqn, a2c")
     train.add_argument("--preset", default=None, help="article | default (default: default)")
-    train.add_argument("--episodes", type=int, default=None, help="episode budget (max_episodes)")
-    train.add_argument("--steps", type=int, default=None, help="env step budget (max_env_steps)")
-    train.add_argument("--seed", type=int, default=0, help="seeds numpy, TensorFlow and the env (default 0)")
+    train.add_argument("--episodes", type=COUNT, default=None, help="episode budget (max_episodes)")
+    train.add_argument("--steps", type=COUNT, default=None, help="env step budget (max_env_steps)")
+    train.add_argument("--seed", type=SEED, default=0,
+                       help="seeds numpy, TensorFlow and the env (default 0); training env seeds stay "
+                            "below 1,000,000, apart from the evaluation seeds")
     train.add_argument("--wandb", default="auto", choices=["auto", "online", "offline", "off"],
                        help="auto = online when logged in, else offline (default auto)")
     train.add_argument("--resume", nargs="?", const="latest", default=None, metavar="RUN_DIR",
                        help="continue a run from its checkpoint (default: the latest run of this algo)")
     train.add_argument("--run-dir", default=None, help="where the run writes (default runs/<name>)")
-    train.add_argument("--final-eval-episodes", type=int, default=None,
+    train.add_argument("--final-eval-episodes", type=NON_NEGATIVE, default=None,
                        help="evaluation episodes after training, on unseen seeds "
                             "(default 100; Mario 10; 0 = none)")
     train.add_argument("--video", action="store_true", help="also render an MP4 of the trained agent")
@@ -226,16 +247,18 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
         p.add_argument("--stage", type=int, default=None, help="Mario: the shipped model of this stage "
                        "(default 1)")
         if name == "evaluate":
-            p.add_argument("--episodes", type=int, default=None, help="default 100; Mario 10")
-            p.add_argument("--seed-base", type=int, default=None,
+            p.add_argument("--episodes", type=COUNT, default=None, help="default 100; Mario 10")
+            p.add_argument("--seed-base", type=NON_NEGATIVE, default=None,
                            help="episode i uses seed SEED_BASE+i (default: the experiment's unseen range)")
             p.add_argument("--record", action="store_true",
                            help="write the result into the model folder's meta.json as its evaluation")
         else:
             p.add_argument("--out", default=None, help="MP4 path (default videos/EXPERIMENT_ALGO.mp4)")
-            p.add_argument("--fps", type=int, default=None, help="frames per second (default: experiment's)")
-            p.add_argument("--episodes", type=int, default=None, help="default 1; Minitaur 3")
-            p.add_argument("--seed", type=int, default=None)
+            p.add_argument("--fps", type=_whole_number(1, 240), default=None,
+                           help="frames per second (default: experiment's)")
+            p.add_argument("--episodes", type=COUNT, default=None, help="default 1; Minitaur 3")
+            p.add_argument("--seed", type=NON_NEGATIVE, default=None,
+                           help="episode i uses seed SEED+i (default: the first evaluation seed)")
     plot = sub.add_parser("plot", help="write the training plots of a run folder (running, interrupted "
                                        "or finished)",
                           description="Write the training plots of a run folder from its CSV tables: score "
@@ -245,18 +268,41 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
     return parser
 
 
+class _Unparsable(Exception):
+    pass
+
+
+class _QuietParser(argparse.ArgumentParser):
+    def error(self, message):
+        raise _Unparsable(message)
+
+
 def _add_hyperparameters(train: argparse.ArgumentParser, argv: list[str]) -> None:
-    """Once EXPERIMENT and ALGO are on the command line, add one flag per hyperparameter."""
+    """Once EXPERIMENT and ALGO are on the command line, add one flag per hyperparameter.
+
+    A first, forgiving parse finds them (and ``--preset``) wherever they stand; a line it cannot
+    read is left to the full parse, which reports it.
+    """
     if argv[:1] != ["train"]:
         return
-    names = [a for a in argv[1:3] if not a.startswith("-")]
-    if len(names) < 2:
+    first = _QuietParser(add_help=False)
+    first.add_argument("experiment")
+    first.add_argument("algo")
+    first.add_argument("--preset")
+    for action in train._actions:  # the other train options, so their values are not taken as names
+        if action.option_strings and action.dest not in ("help", "preset"):
+            if action.nargs == 0:
+                first.add_argument(*action.option_strings, action="store_true")
+            else:
+                first.add_argument(*action.option_strings, nargs=action.nargs, const=action.const)
+    try:
+        names, _ = first.parse_known_args([a for a in argv[1:] if a not in ("-h", "--help")])
+    except _Unparsable:
         return
     from rlcore.experiment import get_experiment
     from rlcore.hparams import add_arguments
 
-    preset = argv[argv.index("--preset") + 1] if "--preset" in argv[:-1] else None
-    add_arguments(train, get_experiment(names[0]).preset(names[1], preset))
+    add_arguments(train, get_experiment(names.experiment).preset(names.algo, names.preset))
 
 
 COMMANDS = {"list": cmd_list, "train": cmd_train, "evaluate": cmd_evaluate, "render": cmd_render,
@@ -267,6 +313,9 @@ def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     try:
         args = build_parser(argv).parse_args(argv)
+        if args.command in ("train", "evaluate", "render"):
+            from rlcore.quiet import load_tensorflow
+            load_tensorflow()  # before any other module imports it: its start-up noise is dropped
         return COMMANDS[args.command](args)
     except UserError as exc:
         print(f"error: {exc}", file=sys.stderr)

@@ -8,16 +8,18 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass, field
 
-from mario_ppo.env import make_env
+from mario_ppo.env import ACTION_SETS, make_env
+from rlcore.allowed import Allowed, choices
 from rlcore.configs import PPOConfig
 from rlcore.experiment import AlgoSpec, Experiment
 
 
 @dataclass(frozen=True)
 class MarioPPOConfig(PPOConfig):
-    world: int = field(default=1, metadata={"help": "world 1-8"})
-    stage: int = field(default=1, metadata={"help": "stage 1-4"})
-    actions: str = field(default="simple", metadata={"help": "simple | complex | right_only"})
+    world: int = field(default=1, metadata={"help": "world", "allowed": Allowed(low=1, high=8)})
+    stage: int = field(default=1, metadata={"help": "stage", "allowed": Allowed(low=1, high=4)})
+    actions: str = field(default="simple", metadata={"help": "button set: 7, 12 or 5 actions",
+                                                     "allowed": choices(*ACTION_SETS)})
 
 
 # Article 001: 8 envs x 512 steps, GAE gamma 0.99 lambda 0.97, clip 0.2, entropy 0.05, Adam 1e-4,

@@ -27,6 +27,7 @@ import numpy as np
 
 from minitaur.motor import OBSERVED_TORQUE_LIMIT, SPEED_LIMIT
 from minitaur.robot import NUM_MOTORS, Minitaur, leg_model_to_motor_angles
+from rlcore.quiet import filtered_stderr
 
 ENV_ID = "deeprl/Minitaur-v0"
 CONTROL_STEP = 0.01
@@ -51,16 +52,18 @@ class MinitaurEnv(gym.Env):
 
     def __init__(self, render_mode: str | None = None, randomize: bool = True,
                  render_size: tuple[int, int] = (320, 240)):
-        import pybullet
-        import pybullet_data
-        from pybullet_utils import bullet_client
-
         if render_mode not in (None, "rgb_array"):
             raise ValueError(f"render_mode {render_mode!r} is not supported; use 'rgb_array' or None")
+        # pybullet prints its build time on import and "argv[0]=" on every connect
+        with filtered_stderr():
+            import pybullet
+            import pybullet_data
+            from pybullet_utils import bullet_client
+
+            self.p = bullet_client.BulletClient(connection_mode=pybullet.DIRECT)
         self.render_mode, self.randomize, self.render_size = render_mode, randomize, render_size
         self._pybullet = pybullet
         self._urdf_root = pybullet_data.getDataPath()
-        self.p = bullet_client.BulletClient(connection_mode=pybullet.DIRECT)
         high = observation_bound().astype(np.float32)
         self.observation_space = gym.spaces.Box(-high, high, dtype=np.float32)
         self.action_space = gym.spaces.Box(-1.0, 1.0, (NUM_MOTORS,), np.float32)

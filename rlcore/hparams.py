@@ -47,7 +47,12 @@ def add_arguments(parser: argparse.ArgumentParser, cfg) -> None:
         shown = ",".join(map(str, value)) if isinstance(value, tuple) else value
         group.add_argument(f"--{f.name.replace('_', '-')}", dest=f"hp_{f.name}", default=None,
                            type=types[f.name], metavar=type(value).__name__.upper(),
-                           help=f"{f.metadata.get('help', '')} (default: {shown})")
+                           help=f"{f.metadata.get('help', '')} (default: {shown}{_allowed_text(f)})")
+
+
+def _allowed_text(f: dataclasses.Field) -> str:
+    allowed = f.metadata.get("allowed")
+    return f"; allowed: {allowed.describe()}" if allowed is not None else ""
 
 
 def overrides_from_args(args: argparse.Namespace) -> dict:

@@ -9,6 +9,7 @@ import keras
 import numpy as np
 
 import rlcore.layers  # noqa: F401  registers our custom layers before deserializing
+import rlcore.quiet  # noqa: F401  drops Keras's "legacy HDF5" log line: .h5 is what we write on purpose
 from rlcore.atomic import atomic_path
 from rlcore.errors import UserError
 

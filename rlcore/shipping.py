@@ -87,10 +87,28 @@ def evaluate_into_meta(model_dir: Path, episodes: int, seed_base: int | None = N
 
 
 def publish(model_dir: Path, target: Path) -> None:
-    """Copy a finished model folder into saved_networks/, each file atomically, meta.json last."""
-    from rlcore.atomic import write_atomic
+    """Make ``target`` (a saved_networks/ folder) an exact copy of ``model_dir``, replacing it whole.
 
-    target.mkdir(parents=True, exist_ok=True)
-    files = sorted(p for p in model_dir.iterdir() if p.is_file() and p.name != "meta.json")
-    for src in files + [model_dir / "meta.json"]:
-        write_atomic(target / src.name, lambda tmp, src=src: shutil.copyfile(src, tmp))
+    The copy is built beside the target, then swapped in with two renames; files of an earlier
+    model that the new one lacks do not survive. A crash leaves either the old folder or the new
+    one in place, plus at most a hidden ``.NAME.old-*`` / ``.NAME.new-*`` folder to delete.
+    """
+    import os
+    import tempfile
+
+    target.parent.mkdir(parents=True, exist_ok=True)
+    fresh = Path(tempfile.mkdtemp(prefix=f".{target.name}.new-", dir=target.parent))
+    try:
+        for src in sorted(p for p in model_dir.iterdir() if p.is_file()):
+            shutil.copyfile(src, fresh / src.name)
+        os.chmod(fresh, 0o755)
+        if target.exists():
+            old = Path(tempfile.mkdtemp(prefix=f".{target.name}.old-", dir=target.parent))
+            os.replace(target, old / target.name)
+            os.replace(fresh, target)
+            shutil.rmtree(old)
+        else:
+            os.replace(fresh, target)
+    finally:
+        if fresh.exists():
+            shutil.rmtree(fresh)

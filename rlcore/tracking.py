@@ -37,6 +37,19 @@ def resolve_wandb_mode(requested: str) -> str:
     return "disabled" if requested == "off" else requested
 
 
+STEP_KEY = "env_steps"  # the x axis of every wandb chart
+
+
+def wandb_row(row: dict, table: str) -> dict:
+    """The numbers of one CSV row as wandb keys: ``metrics`` keys as they are (the article's
+    ``total_points`` ...), other tables' under ``<table>/``; ``env_steps`` is the shared axis."""
+    numbers = {k: v for k, v in row.items()
+               if isinstance(v, (int, float)) and not isinstance(v, bool) and not math.isnan(v)}
+    if table == "metrics":
+        return numbers
+    return {(k if k == STEP_KEY else f"{table}/{k}"): v for k, v in numbers.items()}
+
+
 class Tracker:
     """Logs one row of numbers at a time to wandb and ``<run_dir>/metrics.csv``.
 
@@ -60,6 +73,8 @@ class Tracker:
                 print(f"warning: {exc}; logging offline instead", file=sys.stderr)
                 self.wandb_run = self._start_wandb("offline", run_name, config, wandb_id)
         self.wandb_id = self.wandb_run.id if self.wandb_run else None
+        if self.wandb_run is not None:
+            self._define_axes()
 
     def _start_wandb(self, mode: str, run_name: str, config: dict, wandb_id: str | None):
         os.environ.setdefault("WANDB_SILENT", "true")
@@ -76,6 +91,11 @@ class Tracker:
             reason = str(exc).splitlines()[0][:200] if str(exc) else type(exc).__name__
             raise UserError(f"wandb could not start in {mode} mode ({reason}); "
                             "use --wandb offline (sync later with `wandb sync`) or --wandb off")
+
+    def _define_axes(self) -> None:
+        """Every chart of every table against env steps, not wandb's own call counter."""
+        self.wandb_run.define_metric(STEP_KEY)
+        self.wandb_run.define_metric("*", step_metric=STEP_KEY)
 
     def drop_rows_after(self, env_steps: int) -> dict[str, int]:
         """Remove the rows logged after a checkpoint taken at ``env_steps``.
@@ -120,8 +140,7 @@ class Tracker:
         writer.writerow(row)
         handle.flush()
         if self.wandb_run is not None:
-            self.wandb_run.log({k: v for k, v in row.items()
-                                if isinstance(v, (int, float)) and not math.isnan(v)})
+            self.wandb_run.log(wandb_row(row, table))
 
     def close(self) -> None:
         for handle, _ in self._tables.values():

@@ -43,10 +43,6 @@ def dqn_model_dir(tmp_path):
     (["train", "lunar_lander", "dqn", "--lr", "fast"], "invalid float value: 'fast'"),
     (["evaluate", "lunar_lander", "dqn", "--model", "/nonexistent/model"], "has no meta.json"),
     (["render", "lunar_lander", "sac"], "unknown algorithm 'sac'"),
-    (["train", "mario_ppo", "ppo", "--world", "9", "--num-envs", "1", "--vec", "inline", "--wandb", "off"],
-     "there is no level 9-1"),
-    (["train", "mario_ppo", "ppo", "--actions", "fancy", "--num-envs", "1", "--vec", "inline",
-      "--wandb", "off"], "unknown action set 'fancy'"),
     (["evaluate", "mario_ppo", "ppo", "--model", "/nonexistent/1-1"], "has no meta.json"),
     (["plot", "/nonexistent/run"], "no metrics.csv in /nonexistent/run"),
     (["evaluate", "mario_ppo", "ppo", "--world", "8", "--stage", "4"], "no shipped model for level 8-4; "

@@ -85,9 +85,6 @@ class PPOAgent:
     """Samples actions from pi (numpy RNG) and runs the whole PPO update as one compiled call."""
 
     def __init__(self, obs_shape: tuple, n_actions: int, cfg: PPOConfig):
-        if cfg.value_target not in ("gae", "td0"):
-            from rlcore.errors import UserError
-            raise UserError(f"unknown value_target {cfg.value_target!r}; choose gae or td0")
         self.obs_shape, self.n_actions, self.cfg = tuple(obs_shape), n_actions, cfg
         self.model = build_actor_critic(self.obs_shape, n_actions)
         self.opt = keras.optimizers.Adam(cfg.lr)

@@ -13,6 +13,7 @@ from rlcore.checkpoint import load_checkpoint, save_checkpoint
 from rlcore.errors import UserError
 from rlcore.trainers.session import RunSpec, TrainingSession, check_resumable
 from rlcore.vector import EnvPool, bootstrap_observations
+from rlcore.seeding import training_env_seed
 
 
 def train(spec: RunSpec) -> Path:
@@ -45,7 +46,7 @@ def train(spec: RunSpec) -> Path:
     running = np.zeros(n)
     losses = {"actor_loss": float("nan"), "critic_loss": float("nan"), "entropy": float("nan")}
     # a resumed run starts fresh episodes, reseeded from its episode count
-    obs, _ = envs.reset(seed=[spec.seed * 1000 + session.book.episodes + i for i in range(n)])
+    obs, _ = envs.reset(seed=[training_env_seed(spec.seed, session.book.episodes + i) for i in range(n)])
     next_checkpoint = (session.book.episodes // cfg.checkpoint_every + 1) * cfg.checkpoint_every
     with envs, session.interruptible():
         while not session.should_stop():

@@ -13,13 +13,12 @@ from rlcore.errors import UserError
 from rlcore.replay import ReplayMemory
 from rlcore.trainers import replay_io
 from rlcore.trainers.session import RunSpec, TrainingSession
+from rlcore.seeding import training_env_seed
 
 
 def train(spec: RunSpec) -> Path:
     """Train until the stop score, episode or step budget; return the model folder."""
     cfg = spec.config
-    if cfg.eps_schedule not in ("episode", "steps"):
-        raise UserError(f"unknown eps_schedule {cfg.eps_schedule!r} (episode | steps)")
     keras.utils.set_random_seed(spec.seed)
     env = spec.experiment.make_env(max_episode_steps=cfg.max_episode_steps or None)
     obs_dim, n_actions = env.observation_space.shape[0], int(env.action_space.n)
@@ -40,7 +39,8 @@ def train(spec: RunSpec) -> Path:
         replay_io.save(session, agent, memory, rng, epsilon=epsilon, grad_steps=grad_steps)
 
     update_period = cfg.learn_every * cfg.updates_per_call
-    first_seed = spec.seed + session.book.episodes  # a resumed run reseeds from its episode count
+    # a resumed run reseeds from its episode count
+    first_seed = training_env_seed(spec.seed, session.book.episodes)
     with session.interruptible():
         while not session.should_stop():
             obs, _ = env.reset(seed=first_seed)

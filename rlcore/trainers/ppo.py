@@ -21,6 +21,7 @@ from rlcore.checkpoint import load_checkpoint, save_checkpoint
 from rlcore.errors import UserError
 from rlcore.trainers.session import RunSpec, TrainingSession, check_resumable
 from rlcore.vector import EnvPool
+from rlcore.seeding import training_env_seed
 
 
 def _final(infos: dict, key: str, i: int, default=0):
@@ -57,9 +58,6 @@ class Rollout:
 def train(spec: RunSpec) -> Path:
     cfg, exp = spec.config, spec.experiment
     keras.utils.set_random_seed(spec.seed)
-    if (cfg.n_steps * cfg.num_envs) % cfg.minibatch:
-        raise UserError(f"minibatch {cfg.minibatch} must divide n_steps x num_envs = "
-                        f"{cfg.n_steps * cfg.num_envs}")
     make_env = exp.env_factory(cfg)
     envs = EnvPool([make_env] * cfg.num_envs, mode=cfg.vec)
     obs_shape, n_actions = envs.single_observation_space.shape, int(envs.single_action_space.n)
@@ -88,7 +86,7 @@ def train(spec: RunSpec) -> Path:
     running = np.zeros(n)
     losses = {name: float("nan") for name in LOSS_NAMES}  # CSV columns exist from the first row
     # a resumed run starts fresh episodes, reseeded from its episode count
-    obs, _ = envs.reset(seed=[spec.seed * 1000 + session.book.episodes + i for i in range(n)])
+    obs, _ = envs.reset(seed=[training_env_seed(spec.seed, session.book.episodes + i) for i in range(n)])
     with envs, session.interruptible():
         while not session.should_stop() and not _succeeded(successes, cfg):
             max_x, min_x, ended, flags = -np.inf, np.inf, 0, 0

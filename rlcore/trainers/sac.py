@@ -15,6 +15,7 @@ from rlcore.errors import UserError
 from rlcore.replay import ReplayMemory
 from rlcore.trainers import replay_io
 from rlcore.trainers.session import RunSpec, TrainingSession
+from rlcore.seeding import training_env_seed
 
 
 def train(spec: RunSpec) -> Path:
@@ -39,7 +40,8 @@ def train(spec: RunSpec) -> Path:
                        log_alpha=float(agent.log_alpha.numpy()))
 
     k = cfg.updates_per_call
-    first_seed = spec.seed + session.book.episodes  # a resumed run reseeds from its episode count
+    # a resumed run reseeds from its episode count
+    first_seed = training_env_seed(spec.seed, session.book.episodes)
     with session.interruptible():
         while not session.should_stop():
             obs, _ = env.reset(seed=first_seed)

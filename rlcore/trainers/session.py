@@ -109,7 +109,11 @@ class TrainingSession:
         self.stop_requested = False
         self.best_eval = state.get("best_eval")  # {"mean", "std", "env_steps"} of the best evaluation
         self.best_weights = None  # snapshot of the best evaluation's weights (keep_best)
-        self.next_eval_step = int(state.get("next_eval_step", cfg.eval_every_steps))
+        # periodic greedy evaluations: only the episode-driven configs (EpisodeLoop) have them
+        self.eval_every = getattr(cfg, "eval_every_steps", 0)
+        self.keep_best = getattr(cfg, "keep_best", False)
+        self.stop_eval_score = getattr(cfg, "stop_eval_score", 0.0)
+        self.next_eval_step = int(state.get("next_eval_step", self.eval_every))
         # the command that started the run, then one per resume
         self.commands = list(state.get("commands", [])) + [spec.command]
         self.tracker = Tracker(self.run_dir, self.run_dir.name, self.describe(), spec.wandb_mode,
@@ -162,10 +166,10 @@ class TrainingSession:
         evaluation when ``keep_best`` is set.
         """
         cfg, exp = self.spec.config, self.spec.experiment
-        if not cfg.eval_every_steps or self.env_steps < self.next_eval_step:
+        if not self.eval_every or self.env_steps < self.next_eval_step:
             return
         while self.next_eval_step <= self.env_steps:
-            self.next_eval_step += cfg.eval_every_steps
+            self.next_eval_step += self.eval_every
         from rlcore.evaluation import evaluate
 
         returns = evaluate(exp, greedy_policy, cfg.eval_episodes, seed_base=exp.selection_seed_base,
@@ -175,7 +179,7 @@ class TrainingSession:
                           "eval_mean": mean, "eval_std": std}, table="evals")
         if self.best_eval is None or mean >= self.best_eval["mean"]:
             self.best_eval = {"mean": round(mean, 2), "std": round(std, 2), "env_steps": self.env_steps}
-            if cfg.keep_best:
+            if self.keep_best:
                 self.best_weights = snapshot()
 
     def should_stop(self) -> bool:
@@ -186,7 +190,7 @@ class TrainingSession:
             return True
         if cfg.max_env_steps and self.env_steps >= cfg.max_env_steps:
             return True
-        if cfg.stop_eval_score and self.best_eval and self.best_eval["mean"] >= cfg.stop_eval_score:
+        if self.stop_eval_score and self.best_eval and self.best_eval["mean"] >= self.stop_eval_score:
             return True
         return self.book.full_window() and self.book.average >= cfg.stop_score
 
@@ -235,16 +239,15 @@ class TrainingSession:
         """
         self.progress.close()
         self.tracker.close()
-        kept_best = self.spec.config.keep_best and self.best_weights is not None
+        kept_best = self.keep_best and self.best_weights is not None
         if kept_best:
             load_weights(self.best_weights)
         model_dir = self.run_dir / "model"
         model_dir.mkdir(parents=True, exist_ok=True)
         files = [p.name for p in save_models(model_dir)]
         plot_name = plot_run(self.run_dir, model_dir, self.spec.experiment, self.describe())[0].name
-        for table in ("metrics", "evals"):
-            if self.tracker.table_path(table).exists():
-                (model_dir / f"{table}.csv").write_bytes(self.tracker.table_path(table).read_bytes())
+        for table in sorted(self.run_dir.glob("*.csv")):  # metrics, evals, rollouts: all ship
+            (model_dir / table.name).write_bytes(table.read_bytes())
         meta = {**self.describe(), "command": self.commands[0], "commands": self.commands,
                 "env_steps": self.env_steps,
                 "episodes": self.book.episodes, "wall_seconds": round(self.elapsed(), 1),

@@ -1,0 +1,102 @@
+"""What values a hyperparameter accepts, declared once beside its dataclass field.
+
+    lr: float = _h(1e-3, "learning rate", POSITIVE)
+
+``check_fields(cfg)`` runs every declaration when a config is built (its ``__post_init__``), so a
+bad value from the command line, a preset or a checkpoint is refused before any run folder exists,
+with one line naming the flag, the value and what is allowed. TensorFlow-free.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+from rlcore.errors import UserError
+
+
+@dataclass(frozen=True)
+class Allowed:
+    """A range (``low``/``high``, each inclusive unless ``*_open``) or a set of ``choices``.
+
+    Numbers must also be finite. For a tuple field the rule applies to every item, and the tuple
+    must not be empty.
+    """
+    low: float | None = None
+    high: float | None = None
+    low_open: bool = False
+    high_open: bool = False
+    choices: tuple = ()
+
+    def describe(self) -> str:
+        if self.choices:
+            return "one of " + ", ".join(map(str, self.choices))
+        if self.low is not None and self.high is not None:
+            if not (self.low_open or self.high_open):
+                return f"a number from {self.low:g} to {self.high:g}"
+            left = f"above {self.low:g}" if self.low_open else f"of at least {self.low:g}"
+            right = f"below {self.high:g}" if self.high_open else f"at most {self.high:g}"
+            return f"a number {left} and {right}"
+        if self.low is not None:
+            return f"a number {'above' if self.low_open else 'of at least'} {self.low:g}"
+        if self.high is not None:
+            return f"a number {'below' if self.high_open else 'of at most'} {self.high:g}"
+        return "a finite number"
+
+    def accepts(self, value) -> bool:
+        if self.choices:
+            return value in self.choices
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            return False
+        if self.low is not None and (value <= self.low if self.low_open else value < self.low):
+            return False
+        if self.high is not None and (value >= self.high if self.high_open else value > self.high):
+            return False
+        return True
+
+
+POSITIVE = Allowed(low=0, low_open=True)
+NON_NEGATIVE = Allowed(low=0)
+FINITE = Allowed()
+UNIT = Allowed(low=0, high=1)  # probabilities, discounts, GAE lambda, shares
+COUNT = Allowed(low=1)  # sizes, widths, counts, periods
+OFF_OR_COUNT = NON_NEGATIVE  # budgets and periods where 0 means "off"
+
+
+def choices(*values) -> Allowed:
+    return Allowed(choices=tuple(values))
+
+
+def flag(name: str) -> str:
+    return "--" + name.replace("_", "-")
+
+
+def shown(value) -> str:
+    return ",".join(map(str, value)) if isinstance(value, tuple) else str(value)
+
+
+def invalid(name: str, value, allowed: str) -> UserError:
+    """The one-line error for a bad value of field ``name``."""
+    if isinstance(value, float) and not math.isfinite(value):
+        allowed = allowed.replace("a number", "a finite number")
+    return UserError(f"{flag(name)} {shown(value) or '(empty)'} is invalid: allowed is {allowed}")
+
+
+def check_fields(cfg) -> None:
+    """Raise :class:`UserError` for the first field of ``cfg`` outside its declared ``allowed``."""
+    for f in dataclasses.fields(cfg):
+        allowed = f.metadata.get("allowed")
+        value = getattr(cfg, f.name)
+        if allowed is None:
+            continue
+        if isinstance(value, tuple):
+            if not value or not all(allowed.accepts(item) for item in value):
+                raise invalid(f.name, value, f"a comma-separated list, each item {allowed.describe()}")
+        elif not allowed.accepts(value):
+            raise invalid(f.name, value, allowed.describe())
+
+
+def require(condition: bool, message: str) -> None:
+    """A rule between fields (e.g. the minibatch divides the rollout), checked in ``__post_init__``."""
+    if not condition:
+        raise UserError(message)

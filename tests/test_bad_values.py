@@ -1,0 +1,196 @@
+"""Every bad value is one line naming the flag, exit 2, no run folder, no traceback; and the rough
+edges of a first day: seeds apart from evaluation, no silent flags, a quiet console, wandb axes,
+publishing that replaces a folder whole."""
+import dataclasses
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import main
+from rlcore.experiment import experiment_names, get_experiment
+from rlcore.seeding import MAX_RUN_SEED, TRAINING_SEED_SPAN, training_env_seed
+from tests.test_cli import ROOT, run
+
+BAD_VALUES = [
+    # sizes, widths, counts and budgets
+    (["train", "lunar_lander", "dqn", "--hidden", "0"], "--hidden 0 is invalid"),
+    (["train", "lunar_lander", "dqn", "--hidden", ","], "--hidden (empty) is invalid"),
+    (["train", "cartpole", "a2c", "--num-envs", "0"], "--num-envs 0 is invalid"),
+    (["train", "lunar_lander", "dqn", "--batch-size", "0"], "--batch-size 0 is invalid"),
+    (["train", "lunar_lander", "dqn", "--batch-size", "512", "--buffer-size", "100"],
+     "--batch-size 512 is invalid: it must not exceed --buffer-size 100"),
+    (["train", "lunar_lander", "dqn", "--window", "-3"], "--window -3 is invalid"),
+    (["train", "lunar_lander", "dqn", "--episodes", "-3"], "argument --episodes: -3 is invalid"),
+    (["train", "lunar_lander", "dqn", "--steps", "0"], "argument --steps: 0 is invalid"),
+    (["train", "lunar_lander", "dqn", "--final-eval-episodes", "-1"], "argument --final-eval-episodes: -1"),
+    (["train", "minitaur", "sac", "--learning-starts", "-5"], "--learning-starts -5 is invalid"),
+    # probabilities, discount, tau, lambda, clip
+    (["train", "lunar_lander", "dqn", "--gamma", "1.5"], "--gamma 1.5 is invalid: allowed is a number from 0 to 1"),
+    (["train", "lunar_lander", "dqn", "--tau", "0"], "--tau 0.0 is invalid: allowed is a number above 0 and at most 1"),
+    (["train", "lunar_lander", "dqn", "--eps-end", "-0.1"], "--eps-end -0.1 is invalid"),
+    (["train", "mario_ppo", "ppo", "--gae-lambda", "1.2"], "--gae-lambda 1.2 is invalid"),
+    (["train", "mario_ppo", "ppo", "--clip", "1"], "--clip 1.0 is invalid"),
+    (["train", "mario_ppo", "ppo", "--stop-success-share", "2"], "--stop-success-share 2.0 is invalid"),
+    # learning rates positive and finite
+    (["train", "lunar_lander", "dqn", "--lr", "nan"], "--lr nan is invalid: allowed is a finite number above 0"),
+    (["train", "lunar_lander", "a2c", "--actor-lr", "inf"], "--actor-lr inf is invalid"),
+    (["train", "minitaur", "sac", "--alpha-lr", "0"], "--alpha-lr 0.0 is invalid"),
+    (["train", "lunar_lander", "dqn", "--stop-score", "nan"], "--stop-score nan is invalid"),
+    # choices
+    (["train", "lunar_lander", "dqn", "--optimizer", "sgd"], "--optimizer sgd is invalid: allowed is one of adam, adamw"),
+    (["train", "cartpole", "a2c", "--vec", "threads"], "--vec threads is invalid"),
+    (["train", "mario_ppo", "ppo", "--actions", "fancy"], "--actions fancy is invalid"),
+    (["train", "mario_ppo", "ppo", "--world", "9"], "--world 9 is invalid: allowed is a number from 1 to 8"),
+    # the minibatch divides the rollout; SAC's log-std clip is an interval
+    (["train", "mario_ppo", "ppo", "--minibatch", "300"], "--minibatch 300 is invalid: it must divide the rollout"),
+    (["train", "minitaur", "sac", "--log-std-min", "3"], "--log-std-min 3 is invalid: it must be below"),
+    # seeds, and evaluate / render counts
+    (["train", "lunar_lander", "dqn", "--seed", "-1"], "argument --seed: -1 is invalid"),
+    (["train", "lunar_lander", "dqn", "--seed", str(MAX_RUN_SEED + 1)], "argument --seed:"),
+    (["evaluate", "lunar_lander", "dqn", "--episodes", "0"], "argument --episodes: 0 is invalid"),
+    (["evaluate", "lunar_lander", "dqn", "--episodes", "-2"], "argument --episodes: -2 is invalid"),
+    (["evaluate", "lunar_lander", "dqn", "--seed-base", "-1"], "argument --seed-base: -1 is invalid"),
+    (["render", "lunar_lander", "dqn", "--fps", "0"], "argument --fps: 0 is invalid"),
+    (["render", "lunar_lander", "dqn", "--episodes", "0"], "argument --episodes: 0 is invalid"),
+    (["render", "lunar_lander", "dqn", "--seed", "x"], "argument --seed: 'x' is not a whole number"),
+    # PPO offers no flag it would ignore
+    (["train", "mario_ppo", "ppo", "--keep-best", "true"], "unrecognized arguments: --keep-best"),
+    (["train", "mario_ppo", "ppo", "--eval-every-steps", "1000"], "unrecognized arguments: --eval-every-steps"),
+    (["train", "mario_ppo", "ppo", "--stop-eval-score", "1"], "unrecognized arguments: --stop-eval-score"),
+    (["train", "mario_ppo", "ppo", "--checkpoint-every", "5"], "unrecognized arguments: --checkpoint-every"),
+]
+
+
+@pytest.mark.parametrize("argv, message", BAD_VALUES)
+def test_a_bad_value_is_one_line_exit_2_and_no_run_folder(capsys, tmp_path, argv, message):
+    run_dir = tmp_path / "run"
+    extra = ["--run-dir", str(run_dir), "--wandb", "off"] if argv[0] == "train" else []
+    code, out, err = run(capsys, *argv, *extra)
+    assert code == 2, (out, err)
+    assert message in err, err
+    assert len(err.strip().splitlines()) == 1, err
+    assert "Traceback" not in err
+    assert not run_dir.exists()
+
+
+def _configs():
+    for name in experiment_names():
+        exp = get_experiment(name)
+        for algo, spec in exp.algos.items():
+            for preset in spec.presets:
+                yield f"{name}/{algo}/{preset}", exp.preset(algo, preset)
+
+
+FREE_FORM = {"init_from"}  # a path: checked when it is read
+
+
+@pytest.mark.parametrize("name, cfg", list(_configs()))
+def test_every_field_declares_what_it_allows(name, cfg):
+    for f in dataclasses.fields(cfg):
+        if f.type in ("bool", bool) or f.name in FREE_FORM:
+            continue
+        assert f.metadata.get("allowed") is not None, f"{name}: {f.name} declares no allowed values"
+
+
+def test_help_shows_what_is_allowed(capsys):
+    code, out, _ = run(capsys, "train", "lunar_lander", "dqn", "--help")
+    assert code == 0 and "allowed: a number from 0 to 1" in " ".join(out.split())
+
+
+def test_preset_before_the_names_still_adds_the_hyperparameters(capsys):
+    code, out, _ = run(capsys, "train", "--preset=article", "--seed", "3", "lunar_lander", "dqn", "--help")
+    assert code == 0 and "--tau FLOAT" in out
+
+
+@pytest.mark.parametrize("seed", [0, 7, 999, 1000, 123_456, MAX_RUN_SEED])
+def test_training_seeds_never_reach_the_evaluation_or_selection_seeds(seed):
+    lowest = min(min(get_experiment(n).eval_seed_base, get_experiment(n).selection_seed_base)
+                 for n in experiment_names())
+    assert lowest >= TRAINING_SEED_SPAN
+    for index in (0, 1, 999, 10_000, 5_000_000):
+        assert 0 <= training_env_seed(seed, index) < TRAINING_SEED_SPAN
+
+
+def test_seed_zero_keeps_the_env_seeds_of_the_shipped_runs():
+    assert [training_env_seed(0, i) for i in range(5)] == [0, 1, 2, 3, 4]
+
+
+NOISE = ("oneDNN", "cuInit", "cuda", "absl", "argv[0]", "pybullet build time", "HDF5")
+
+
+def _cli(*argv, cwd):
+    env = {k: v for k, v in os.environ.items() if k not in ("TF_CPP_MIN_LOG_LEVEL", "WANDB_SILENT")}
+    done = subprocess.run([sys.executable, str(ROOT / "main.py"), *argv], cwd=cwd, env=env,
+                          capture_output=True, text=True, timeout=300)
+    return done.returncode, done.stdout + done.stderr
+
+
+@pytest.mark.parametrize("argv", [["list"], ["train", "lunar_lander", "dqn", "--help"]])
+def test_list_and_help_print_no_tensorflow_line(argv, tmp_path):
+    code, text = _cli(*argv, cwd=tmp_path)
+    assert code == 0
+    assert not [word for word in NOISE if word in text], text
+
+
+def test_training_and_minitaur_evaluation_print_only_our_lines(tmp_path):
+    code, text = _cli("train", "lunar_lander", "dqn", "--episodes", "2", "--wandb", "off", "--no-progress",
+                      "--final-eval-episodes", "0", "--run-dir", str(tmp_path / "run"), cwd=tmp_path)
+    assert code == 0 and "trained: 2 episodes" in text
+    code2, text2 = _cli("evaluate", "minitaur", "sac", "--episodes", "1", cwd=tmp_path)
+    assert code2 == 0 and "greedy return" in text2
+    assert not [word for word in NOISE if word in text + text2], text + text2
+
+
+def test_the_console_script_finds_shipped_models_from_elsewhere(tmp_path):
+    script = Path(sys.executable).parent / "deeprl"
+    if not script.exists():
+        pytest.skip("the deeprl console script is installed by `make venv`")
+    done = subprocess.run([str(script), "evaluate", "cartpole", "dqn", "--episodes", "2"], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert "greedy return 500.0" in done.stdout
+
+
+def test_wandb_charts_every_table_against_env_steps(tmp_path, monkeypatch):
+    import wandb.sdk.wandb_run as wandb_run
+
+    from rlcore.tracking import Tracker, wandb_row
+
+    defined = []
+    original = wandb_run.Run.define_metric
+
+    def spy(self, name, *args, **kwargs):
+        defined.append((name, kwargs.get("step_metric")))
+        return original(self, name, *args, **kwargs)
+    monkeypatch.setattr(wandb_run.Run, "define_metric", spy)
+    tracker = Tracker(tmp_path, "t", {}, "offline")
+    tracker.log({"episode": 1, "total_points": 3.0, "env_steps": 10})
+    tracker.log({"env_steps": 10, "eval_mean": 1.5}, table="evals")
+    tracker.close()
+    assert ("env_steps", None) in defined and ("*", "env_steps") in defined
+    assert list((tmp_path / "wandb").glob("offline-run-*/run-*.wandb"))
+    assert wandb_row({"env_steps": 10, "eval_mean": 1.5, "flag": True}, "evals") == {
+        "env_steps": 10, "evals/eval_mean": 1.5}
+    assert wandb_row({"episode": 1, "total_points": 3.0, "env_steps": 10}, "metrics") == {
+        "episode": 1, "total_points": 3.0, "env_steps": 10}
+
+
+def test_publish_replaces_the_shipped_folder_whole(tmp_path):
+    from rlcore.shipping import publish
+
+    model = tmp_path / "run" / "model"
+    model.mkdir(parents=True)
+    for name in ("q_network.h5", "meta.json", "metrics.csv", "rollouts.csv"):
+        (model / name).write_text(f"new {name}")
+    target = tmp_path / "saved" / "dqn"
+    target.mkdir(parents=True)
+    (target / "meta.json").write_text("old")
+    (target / "Stale_Train_dqn.png").write_text("old plot")
+    publish(model, target)
+    assert sorted(p.name for p in target.iterdir()) == ["meta.json", "metrics.csv", "q_network.h5",
+                                                        "rollouts.csv"]
+    assert (target / "meta.json").read_text() == "new meta.json"
+    assert [p.name for p in target.parent.iterdir()] == ["dqn"]  # no temporary folder left
