@@ -81,8 +81,20 @@ class ArticleShaping(gym.Wrapper):
 
 
 def gray_84(frame: np.ndarray) -> np.ndarray:
-    """RGB NES frame (240x256x3) -> gray uint8 84x84 (the article's cv2 gray + resize)."""
-    return cv2.resize(cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY), (FRAME_SIZE, FRAME_SIZE))
+    """RGB NES frame (240x256x3) -> gray uint8 84x84 (the article's cv2 gray + resize).
+
+    nes-py hands out its screen as a zero-copy RGB view of the emulator's 32-bit BGRx pixels
+    (strides ``(1024, 4, -1)``). cv2 would first copy that view into a contiguous RGB image, which
+    cost 0.64 ms a frame here; reading the same bytes as contiguous BGRA takes 0.07 ms and gives
+    the same gray image, bit for bit (the same weights on the same channels).
+    """
+    if frame.ndim == 3 and frame.strides[1:] == (4, -1):
+        bgrx = np.lib.stride_tricks.as_strided(frame[:, :, ::-1], (*frame.shape[:2], 4),
+                                               (frame.strides[0], 4, 1), writeable=False)
+        gray = cv2.cvtColor(bgrx, cv2.COLOR_BGRA2GRAY)
+    else:
+        gray = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
+    return cv2.resize(gray, (FRAME_SIZE, FRAME_SIZE))
 
 
 class SkipAndStack(gym.Wrapper):

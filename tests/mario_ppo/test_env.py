@@ -94,3 +94,18 @@ def test_rgb_array_keeps_every_emulator_frame_for_video():
     frames = env.get_wrapper_attr("frames")
     assert len(frames) == 4 and frames[0].shape == (240, 256, 3)
     env.close()
+
+
+def test_gray_of_the_emulator_screen_view_equals_cv2_on_a_contiguous_copy(env):
+    import cv2
+
+    env.reset(seed=0)
+    screen = env.unwrapped.screen  # nes-py's zero-copy view of its BGRx pixels
+    assert screen.strides[1:] == (4, -1)
+    rng = np.random.default_rng(0)
+    for _ in range(40):
+        if env.step(int(rng.integers(env.action_space.n)))[2]:
+            env.reset()
+        want = cv2.resize(cv2.cvtColor(np.ascontiguousarray(screen), cv2.COLOR_RGB2GRAY),
+                          (FRAME_SIZE, FRAME_SIZE))
+        np.testing.assert_array_equal(gray_84(screen), want)
