@@ -179,3 +179,47 @@ def test_init_from_a_model_of_another_experiment_is_refused(tmp_path):
         ppo_trainer.train(spec)
     with pytest.raises(UserError, match="no meta.json"):
         ppo_trainer.train(toy.spec("ppo", tmp_path / "c", init_from=str(tmp_path)))
+
+
+def test_a_run_resumes_from_what_git_keeps_of_it(tmp_path):
+    """long_runs/: the checkpoint and CSV tables are committed, the wandb folder is ignored; a clone
+    on another machine resumes the run with its counters."""
+    import shutil
+    import subprocess
+
+    from tests.test_cli import ROOT
+
+    def git(*args, cwd):
+        subprocess.run(["git", "-c", "user.name=t", "-c", "user.email=t@t", *args], cwd=cwd, check=True,
+                       capture_output=True)
+
+    repo = tmp_path / "repo"
+    run_dir = repo / "long_runs" / "toy_image" / "ppo"
+    spec = toy.spec("ppo", tmp_path, stop_score=99.0, max_episodes=30, stop_success_share=0.0)
+    spec.run_dir, spec.wandb_mode = run_dir, "offline"
+    from rlcore.trainers import session as session_mod
+    original = session_mod.TrainingSession.end_episode
+
+    def end_episode(self, episode_return, extra):
+        original(self, episode_return, extra)
+        if self.book.episodes == 12:
+            self.stop_requested = True
+    session_mod.TrainingSession.end_episode = end_episode
+    try:
+        with pytest.raises(Interrupted):
+            ppo_trainer.train(spec)
+    finally:
+        session_mod.TrainingSession.end_episode = original
+    assert (run_dir / "wandb").is_dir()
+    shutil.copyfile(ROOT / ".gitignore", repo / ".gitignore")
+    git("init", "-q", cwd=repo)
+    git("add", "-A", cwd=repo)
+    git("commit", "-q", "-m", "checkpoint", cwd=repo)
+    git("clone", "-q", str(repo), str(tmp_path / "clone"), cwd=tmp_path)
+    cloned = tmp_path / "clone" / "long_runs" / "toy_image" / "ppo"
+    assert sorted(p.name for p in cloned.iterdir()) == ["checkpoint.npz", "metrics.csv", "rollouts.csv"]
+    before = read_checkpoint_state(cloned / "checkpoint.npz")
+    spec.run_dir, spec.resume, spec.wandb_mode, spec.command = cloned, True, "off", "pytest --resume"
+    meta = json.loads((ppo_trainer.train(spec) / "meta.json").read_text())
+    assert meta["commands"] == ["pytest", "pytest --resume"]
+    assert meta["episodes"] >= 30 and meta["env_steps"] > before["env_steps"]
