@@ -39,43 +39,35 @@ def cmd_list(args) -> int:
 
 
 def _spec_from_args(args):
-    from rlcore.experiment import get_experiment
-    from rlcore.hparams import apply_overrides, overrides_from_args
-    from rlcore.trainers.session import RunSpec, check_resumable, latest_run_dir, new_run_dir
+    from rlcore.hparams import overrides_from_args
+    from rlcore.run import build_spec
+    from rlcore.trainers.session import latest_run_dir, new_run_dir
 
-    exp = get_experiment(args.experiment)
     overrides = overrides_from_args(args)
     if args.episodes is not None:
         overrides["max_episodes"] = args.episodes
     if args.steps is not None:
         overrides["max_env_steps"] = args.steps
+    common = dict(preset=args.preset, seed=args.seed, overrides=overrides, wandb_mode=args.wandb,
+                  progress=not args.no_progress)
     if args.resume is not None:
-        run_dir = latest_run_dir(exp.name, args.algo) if args.resume == "latest" else Path(args.resume)
-        spec = RunSpec(exp, args.algo, args.preset or "", None, args.seed, args.wandb, run_dir, True,
-                       progress=not args.no_progress)
-        state = check_resumable(spec)
-        from rlcore.hparams import from_dict
-        config_class = type(exp.preset(args.algo, None))
-        # the checkpoint's own hyperparameters; budgets may be raised from the command line
-        spec.config = apply_overrides(from_dict(config_class, state["config"]), overrides)
-        spec.preset, spec.seed = state["preset"], state["seed"]
+        run_dir = latest_run_dir(args.experiment, args.algo) if args.resume == "latest" else Path(args.resume)
+        spec = build_spec(args.experiment, args.algo, run_dir=run_dir, resume=True, **common)
+        from rlcore.checkpoint import read_checkpoint_state
+        state = read_checkpoint_state(run_dir / "checkpoint.npz")
         print(f"resuming {run_dir} at episode {len(state['returns'])}, env step {state['env_steps']}")
         return spec
-    config = apply_overrides(exp.preset(args.algo, args.preset), overrides)
-    preset = args.preset or exp.algo(args.algo).default_preset
-    return RunSpec(exp, args.algo, preset, config, args.seed, args.wandb,
-                   Path(args.run_dir) if args.run_dir else new_run_dir(exp.name, args.algo, args.seed),
-                   progress=not args.no_progress)
+    run_dir = Path(args.run_dir) if args.run_dir else new_run_dir(args.experiment, args.algo, args.seed)
+    return build_spec(args.experiment, args.algo, run_dir=run_dir, **common)
 
 
 def cmd_train(args) -> int:
-    import importlib
+    from rlcore.run import run_training
 
     spec = _spec_from_args(args)
-    trainer = importlib.import_module(f"rlcore.trainers.{spec.kind}")
     print(f"training {spec.experiment.name} {spec.algo} ({spec.preset} preset, seed {spec.seed}) "
           f"-> {spec.run_dir}")
-    model_dir = trainer.train(spec)
+    model_dir = run_training(spec)
     meta = json.loads((model_dir / "meta.json").read_text())
     print(f"trained: {meta['episodes']} episodes, {meta['env_steps']} env steps, "
           f"{meta['wall_seconds']:.0f} s; last-100 average {meta['final_average']:.1f}")
@@ -175,6 +167,59 @@ def cmd_plot(args) -> int:
     return 0
 
 
+def cmd_sweep(args) -> int:
+    from rlcore.experiment import get_experiment
+    from rlcore.sweep import SWEEPS_DIR, Sweep, parse_grid, parse_seeds, run_sweep
+
+    exp = get_experiment(args.experiment)
+    base = exp.preset(args.algo, args.preset)
+    name = args.name or f"{args.experiment}__{args.algo}"
+    folder = (SWEEPS_DIR / name).resolve()
+    if args.resume:
+        sweep = Sweep.load(folder)
+        if (sweep.experiment, sweep.algo) != (args.experiment, args.algo):
+            raise UserError(f"sweep {name} runs {sweep.experiment} {sweep.algo}, not {args.experiment} {args.algo}")
+    else:
+        if (folder / "sweep.json").exists():
+            raise UserError(f"sweep {name} exists in {folder}; continue it with --resume or pick another --name")
+        overrides = {}
+        if args.episodes is not None:
+            overrides["max_episodes"] = args.episodes
+        if args.steps is not None:
+            overrides["max_env_steps"] = args.steps
+        sweep = Sweep(args.experiment, args.algo, name, str(folder), parse_seeds(args.seeds),
+                      parse_grid(args.grid, base), args.preset, overrides, args.cpus_per_run,
+                      args.max_concurrent, args.final_eval_episodes)
+    trials = sweep.trials()
+    print(f"sweep {name}: {len(trials)} trials of {sweep.experiment} {sweep.algo} -> {folder}/")
+    rows = run_sweep(sweep, address=args.address, num_cpus=args.num_cpus)
+    for row in sorted(rows, key=lambda r: r["trial"]):
+        if row.get("error"):
+            status = f"failed: {row['error']}"
+        elif row.get("interrupted"):
+            status = "stopped at a checkpoint (--resume continues it)"
+        else:
+            status = (f"final score {row.get('final_score', float('nan')):.3f}, {row.get('env_steps', 0):,} env steps"
+                      + (" (finished earlier)" if row.get("skipped") else ""))
+        print(f"  {row['trial']}: {status}")
+    print(f"report: python main.py report {folder}")
+    return 130 if (folder / "STOP").exists() else 0
+
+
+def cmd_report(args) -> int:
+    from rlcore.report import markdown, plot_curves, summarize
+
+    result = summarize([Path(d) for d in args.sweep_dirs], reps=args.reps)
+    text = markdown(result)
+    print(text)
+    first = Path(args.sweep_dirs[0])
+    from rlcore.atomic import write_atomic
+    write_atomic(first / "report.md", lambda p: p.write_text(text + "\n"))
+    png = plot_curves(result, first / "report_curves.png")
+    print(f"written: {first / 'report.md'}, {png}")
+    return 0
+
+
 # ------------------------------------------------------------------ parser
 class _Parser(argparse.ArgumentParser):
     """argparse that reports a bad command line as one line (and exit status 2)."""
@@ -259,6 +304,40 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
             p.add_argument("--episodes", type=COUNT, default=None, help="default 1; Minitaur 3")
             p.add_argument("--seed", type=NON_NEGATIVE, default=None,
                            help="episode i uses seed SEED+i (default: the first evaluation seed)")
+    sweep = sub.add_parser(
+        "sweep", help="many runs (seeds x grid values) on Ray Tune, locally or on a cluster",
+        description="One trial per combination of --seeds and --grid values; each trial is an ordinary "
+                    "run folder under sweeps/NAME/ (evaluate, render and plot work on it). A trial "
+                    "restarted after a crash resumes from its checkpoint; Ctrl-C stops every trial at a "
+                    "checkpoint; --resume continues and skips finished trials.")
+    sweep.add_argument("experiment")
+    sweep.add_argument("algo")
+    sweep.add_argument("--seeds", default="0-4", help="a range or a list: 0-4, 0,3,7 (default 0-4)")
+    sweep.add_argument("--grid", action="append", default=[], metavar="NAME=V1,V2",
+                       help="a hyperparameter and its values (repeatable), e.g. --grid lr=1e-4,3e-4")
+    sweep.add_argument("--preset", default=None, help="article | default (default: default)")
+    sweep.add_argument("--episodes", type=COUNT, default=None, help="episode budget of each run")
+    sweep.add_argument("--steps", type=COUNT, default=None, help="env step budget of each run")
+    sweep.add_argument("--final-eval-episodes", type=NON_NEGATIVE, default=None,
+                       help="evaluation episodes on unseen seeds after each run (default 100; Mario 10)")
+    sweep.add_argument("--max-concurrent", type=NON_NEGATIVE, default=0,
+                       help="trials at once (default 0: as many as the CPUs allow)")
+    sweep.add_argument("--cpus-per-run", type=_whole_number(1, 256), default=1,
+                       help="CPUs reserved per trial; TensorFlow's threads follow it (default 1)")
+    sweep.add_argument("--num-cpus", type=COUNT, default=None,
+                       help="CPUs of the local Ray instance (default: all of this machine's)")
+    sweep.add_argument("--name", default=None, help="sweep folder name (default EXPERIMENT__ALGO)")
+    sweep.add_argument("--address", default=None,
+                       help="join a running Ray cluster (e.g. 10.0.0.5:6379) instead of starting local Ray")
+    sweep.add_argument("--resume", action="store_true", help="continue the sweep NAME; finished trials are kept")
+    report = sub.add_parser("report", help="results of sweeps: per run, and mean / median / IQM with 95% CIs",
+                            description="Per run: the final evaluation on unseen seeds, env steps, wall time. "
+                                        "Over runs: mean, median and IQM with 95%% stratified bootstrap CIs "
+                                        "(rliable's method); with two sweeps, P(first beats second). Writes "
+                                        "report.md and report_curves.png into the first sweep folder.")
+    report.add_argument("sweep_dirs", nargs="+", metavar="SWEEP_DIR")
+    report.add_argument("--reps", type=_whole_number(100, 10**6), default=5000, help="bootstrap resamples")
+
     plot = sub.add_parser("plot", help="write the training plots of a run folder (running, interrupted "
                                        "or finished)",
                           description="Write the training plots of a run folder from its CSV tables: score "
@@ -306,7 +385,7 @@ def _add_hyperparameters(train: argparse.ArgumentParser, argv: list[str]) -> Non
 
 
 COMMANDS = {"list": cmd_list, "train": cmd_train, "evaluate": cmd_evaluate, "render": cmd_render,
-            "plot": cmd_plot}
+            "plot": cmd_plot, "sweep": cmd_sweep, "report": cmd_report}
 
 
 def main(argv: list[str] | None = None) -> int:

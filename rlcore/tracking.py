@@ -57,8 +57,9 @@ class Tracker:
     """
 
     def __init__(self, run_dir: str | Path, run_name: str, config: dict, wandb_mode: str = "auto",
-                 wandb_id: str | None = None):
+                 wandb_id: str | None = None, on_row=None):
         self.run_dir = Path(run_dir)
+        self.on_row = on_row  # on_row(row, table): also hand every row to a caller (a Ray trial)
         self.run_dir.mkdir(parents=True, exist_ok=True)
         self.csv_path = self.run_dir / "metrics.csv"
         self._tables: dict[str, tuple] = {}  # table name -> (file, csv.DictWriter)
@@ -141,6 +142,8 @@ class Tracker:
         handle.flush()
         if self.wandb_run is not None:
             self.wandb_run.log(wandb_row(row, table))
+        if self.on_row is not None:
+            self.on_row(row, table)
 
     def close(self) -> None:
         for handle, _ in self._tables.values():

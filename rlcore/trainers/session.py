@@ -8,10 +8,12 @@ import platform
 import shlex
 import signal
 import sys
+import threading
 import time
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 from tqdm import tqdm
@@ -49,6 +51,10 @@ class RunSpec:
     resume: bool = False
     command: str = field(default_factory=lambda: " ".join(shlex.quote(a) for a in ["python", *sys.argv]))
     progress: bool = True
+    # on_progress(row, table): every row the run logs (episodes, evaluations, rollouts), as it comes
+    on_progress: Callable[[dict, str], None] | None = None
+    # a file whose appearance stops the run at its next safe point, with a checkpoint (sweeps' Ctrl-C)
+    stop_file: Path | None = None
 
     @property
     def kind(self) -> str:
@@ -117,6 +123,7 @@ class TrainingSession:
         # the command that started the run, then one per resume
         self.commands = list(state.get("commands", [])) + [spec.command]
         self.tracker = Tracker(self.run_dir, self.run_dir.name, self.describe(), spec.wandb_mode,
+                               on_row=spec.on_progress,
                                wandb_id=state.get("wandb_id"))
         if resumed_state:
             dropped = self.tracker.drop_rows_after(self.env_steps)
@@ -184,6 +191,8 @@ class TrainingSession:
 
     def should_stop(self) -> bool:
         cfg = self.spec.config
+        if self.spec.stop_file is not None and self.spec.stop_file.exists():
+            self.stop_requested = True
         if self.stop_requested:
             return True
         if self.book.episodes >= cfg.max_episodes:
@@ -225,6 +234,9 @@ class TrainingSession:
             self.stop_requested = True
             tqdm.write("\nCtrl-C: stopping at the next safe point and saving a checkpoint "
                        "(press again to abort without saving)")
+        if threading.current_thread() is not threading.main_thread():
+            yield  # a Ray trial runs in a worker thread: its sweep stops it through spec.stop_file
+            return
         previous = signal.signal(signal.SIGINT, handler)
         try:
             yield

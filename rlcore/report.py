@@ -1,0 +1,162 @@
+"""``main.py report``: per-run results of one or more sweeps, aggregated with confidence intervals.
+
+Statistics follow rliable (Agarwal et al. 2021): mean, median and interquartile mean (IQM) of the
+runs' final scores, each with a 95 % stratified percentile bootstrap interval, and the probability
+that one sweep's runs beat another's. The aggregates and the probability of improvement are
+rliable's own (``rliable.metrics``); the bootstrap is written here because ``rliable.library``
+calls ``arch``, and neither arch 7 (it fails to import with pandas 3) nor arch 8 (it no longer
+takes rliable's ``random_state`` argument) works with it on Python 3.13 today.
+
+A run's final score is the evaluation on unseen seeds in its ``model/meta.json``: the greedy mean
+return, or for Mario the share of episodes that reached the flag. TensorFlow-free.
+"""
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+
+import numpy as np
+
+from rlcore.errors import UserError
+
+AGGREGATES = ("mean", "median", "iqm")
+
+
+def aggregates(scores: np.ndarray) -> np.ndarray:
+    """[mean, median, IQM] of a (runs, tasks) score matrix, as rliable computes them."""
+    from rliable import metrics
+
+    return np.array([metrics.aggregate_mean(scores), metrics.aggregate_median(scores),
+                     metrics.aggregate_iqm(scores)])
+
+
+def stratified_bootstrap_ci(statistic, *matrices: np.ndarray, reps: int = 5000, level: float = 0.95,
+                            seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """Percentile interval of ``statistic(*matrices)`` under rliable's stratified bootstrap.
+
+    Each matrix is (runs, tasks); a resample draws, for every task separately, as many runs with
+    replacement as there are (the strata are the tasks). Returns ``(point, [low, high])``.
+    """
+    rng = np.random.default_rng(seed)
+    point = np.asarray(statistic(*matrices))
+    draws = []
+    for _ in range(reps):
+        resampled = []
+        for m in matrices:
+            runs, tasks = m.shape
+            rows = rng.integers(0, runs, (runs, tasks))
+            resampled.append(np.take_along_axis(m, rows, axis=0))
+        draws.append(statistic(*resampled))
+    tail = (1 - level) / 2 * 100
+    return point, np.percentile(np.asarray(draws), [tail, 100 - tail], axis=0)
+
+
+def probability_of_improvement(x: np.ndarray, y: np.ndarray) -> float:
+    """P(a run of X scores above a run of Y), ties counting half (rliable's definition)."""
+    from rliable import metrics
+
+    return float(metrics.probability_of_improvement(x, y))
+
+
+# --------------------------------------------------------------------------------- run folders
+def load_runs(sweep_dir: Path) -> list[dict]:
+    """One row per run folder of a sweep: trial, final score, env steps, wall time (finished only)."""
+    sweep_dir = Path(sweep_dir)
+    if not sweep_dir.is_dir():
+        raise UserError(f"no sweep folder {sweep_dir}")
+    rows = []
+    for meta_path in sorted(sweep_dir.glob("*/model/meta.json")):
+        meta = json.loads(meta_path.read_text())
+        ev = meta.get("evaluation") or {}
+        score = ev.get("success_share", ev.get("mean"))
+        if score is None:
+            continue  # trained but not evaluated: nothing to aggregate
+        rows.append({"trial": meta_path.parent.parent.name, "seed": meta["seed"], "score": float(score),
+                     "eval_episodes": ev.get("episodes"), "env_steps": meta["env_steps"],
+                     "wall_seconds": meta["wall_seconds"], "run_dir": meta_path.parent.parent})
+    if not rows:
+        raise UserError(f"{sweep_dir} holds no finished, evaluated run (model/meta.json with an evaluation)")
+    return rows
+
+
+def learning_curve(run_dirs: list[Path], points: int = 40) -> tuple[np.ndarray, np.ndarray]:
+    """(env steps grid, [runs, points] 100-episode average return), each run interpolated."""
+    curves = []
+    for run_dir in run_dirs:
+        with open(Path(run_dir) / "metrics.csv", newline="") as f:
+            rows = list(csv.DictReader(f))
+        steps = np.array([float(r["env_steps"]) for r in rows])
+        values = np.array([float(r["av_latest_points"]) for r in rows])
+        curves.append((steps, values))
+    end = min(s[-1] for s, _ in curves)
+    grid = np.linspace(0, end, points)
+    return grid, np.stack([np.interp(grid, s, v) for s, v in curves])
+
+
+# --------------------------------------------------------------------------------------- report
+def summarize(sweep_dirs: list[Path], reps: int = 5000) -> dict:
+    """Everything ``main.py report`` prints, as numbers."""
+    sweeps = []
+    for folder in sweep_dirs:
+        runs = load_runs(folder)
+        scores = np.array([[r["score"]] for r in runs])
+        point, ci = stratified_bootstrap_ci(aggregates, scores, reps=reps)
+        sweeps.append({"folder": Path(folder), "runs": runs,
+                       "aggregates": {name: (float(point[i]), float(ci[0][i]), float(ci[1][i]))
+                                      for i, name in enumerate(AGGREGATES)}})
+    result = {"sweeps": sweeps}
+    if len(sweeps) == 2:
+        x, y = (np.array([[r["score"]] for r in s["runs"]]) for s in sweeps)
+        point, ci = stratified_bootstrap_ci(lambda a, b: probability_of_improvement(a, b), x, y, reps=reps)
+        result["probability_of_improvement"] = (float(point), float(ci[0]), float(ci[1]))
+    return result
+
+
+def markdown(result: dict) -> str:
+    lines = []
+    for s in result["sweeps"]:
+        lines += [f"## {s['folder']}", "", "| run | seed | final score (unseen seeds) | env steps | wall |",
+                  "| --- | ---: | ---: | ---: | ---: |"]
+        lines += [f"| {r['trial']} | {r['seed']} | {r['score']:.3f} | {r['env_steps']:,} | {r['wall_seconds']:.0f} s |"
+                  for r in s["runs"]]
+        lines += ["", f"| over {len(s['runs'])} runs | point | 95% CI (stratified bootstrap) |", "| --- | ---: | --- |"]
+        lines += [f"| {name} | {p:.3f} | [{lo:.3f}, {hi:.3f}] |" for name, (p, lo, hi) in s["aggregates"].items()]
+        lines.append("")
+    if "probability_of_improvement" in result:
+        p, lo, hi = result["probability_of_improvement"]
+        first, second = (s["folder"] for s in result["sweeps"])
+        lines += [f"P({first} > {second}) = {p:.3f} [{lo:.3f}, {hi:.3f}]", ""]
+    return "\n".join(lines)
+
+
+def plot_curves(result: dict, out: Path, reps: int = 1000) -> Path:
+    """IQM of the 100-episode average return over env steps, with its 95 % CI band, per sweep."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from rliable import metrics
+
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    for s in result["sweeps"]:
+        grid, curves = learning_curve([r["run_dir"] for r in s["runs"]])
+        iqm, low, high = [], [], []
+        for j in range(len(grid)):
+            point, ci = stratified_bootstrap_ci(metrics.aggregate_iqm, curves[:, j:j + 1], reps=reps)
+            iqm.append(float(point))
+            low.append(float(ci[0]))
+            high.append(float(ci[1]))
+        ax.plot(grid, iqm, label=f"{s['folder'].name} (IQM of {len(s['runs'])} runs)")
+        ax.fill_between(grid, low, high, alpha=0.25)
+    ax.set_xlabel("env steps")
+    ax.set_ylabel("100-episode average return")
+    ax.legend()
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    out = Path(out)
+    from rlcore.atomic import atomic_path
+    with atomic_path(out) as tmp:
+        fig.savefig(tmp, dpi=110)
+    plt.close(fig)
+    return out

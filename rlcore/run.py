@@ -1,0 +1,50 @@
+"""One training run as one function: what ``main.py train``, a Ray trial and the tests all call.
+
+    spec = build_spec("lunar_lander", "dqn", seed=0, overrides={"lr": 5e-4}, run_dir=Path("runs/x"))
+    model_dir = run_training(spec, on_progress=lambda row, table: ...)
+
+``build_spec`` turns names, a preset and overrides into a checked :class:`RunSpec` (an invalid
+value is a :class:`UserError` before any folder exists); with ``resume`` it takes the
+hyperparameters from the run folder's checkpoint, overrides on top. TensorFlow is imported only by
+``run_training`` (through the trainer).
+"""
+from __future__ import annotations
+
+import importlib
+from pathlib import Path
+from typing import Callable
+
+from rlcore.experiment import get_experiment
+from rlcore.hparams import apply_overrides, from_dict
+from rlcore.trainers.session import RunSpec, check_resumable
+
+
+def build_spec(experiment: str, algo: str, *, preset: str | None = None, seed: int = 0,
+               overrides: dict | None = None, run_dir: Path, resume: bool = False,
+               wandb_mode: str = "auto", progress: bool = True, command: str | None = None) -> RunSpec:
+    """The :class:`RunSpec` of a new run (``resume=False``) or of the run in ``run_dir``."""
+    exp = get_experiment(experiment)
+    overrides = dict(overrides or {})
+    extra = {} if command is None else {"command": command}
+    if resume:
+        spec = RunSpec(exp, algo, preset or "", None, seed, wandb_mode, Path(run_dir), True,
+                       progress=progress, **extra)
+        state = check_resumable(spec)
+        config_class = type(exp.preset(algo, None))
+        # the checkpoint's own hyperparameters; budgets (or any field) may be given again
+        spec.config = apply_overrides(from_dict(config_class, state["config"]), overrides)
+        spec.preset, spec.seed = state["preset"], state["seed"]
+        return spec
+    config = apply_overrides(exp.preset(algo, preset), overrides)
+    return RunSpec(exp, algo, preset or exp.algo(algo).default_preset, config, seed, wandb_mode,
+                   Path(run_dir), progress=progress, **extra)
+
+
+def run_training(spec: RunSpec, on_progress: Callable[[dict, str], None] | None = None) -> Path:
+    """Train ``spec`` to its end; return the model folder. ``on_progress(row, table)`` sees every row
+    the run logs as it is logged. Ctrl-C (or ``spec.stop_file``) raises ``Interrupted`` after the
+    checkpoint is written."""
+    if on_progress is not None:
+        spec.on_progress = on_progress
+    trainer = importlib.import_module(f"rlcore.trainers.{spec.kind}")
+    return trainer.train(spec)

@@ -1,0 +1,256 @@
+"""Sweeps on Ray Tune: one trial per (seed, grid value ...) combination, each an ordinary run folder.
+
+    sweeps/<name>/sweep.json            what the sweep is (experiment, algo, preset, seeds, grid, budgets)
+    sweeps/<name>/<trial>/              metrics.csv, checkpoint.npz, model/ (meta.json) ...: a run folder
+    sweeps/<name>/_tune/                Ray Tune's own records
+
+A trial calls :func:`rlcore.run.run_training`, the function ``main.py train`` calls, and reports
+every logged row to Tune as it comes. Fault tolerance lives in the run folder, not in Tune: a trial
+that starts where a checkpoint exists resumes it (so a trial whose worker was killed and that Tune
+restarts continues its counters), and a trial whose ``model/meta.json`` exists is finished and is
+not run again (``--resume``). Ctrl-C writes ``sweeps/<name>/STOP``: every running trial stops at
+its next safe point with a checkpoint, and the sweep ends.
+
+Local Ray is started here with a fixed CPU count, no dashboard and every service on 127.0.0.1;
+``address`` joins an existing cluster instead. This module is TensorFlow-free (trials import it).
+"""
+from __future__ import annotations
+
+import itertools
+import json
+import os
+import signal
+import sys
+import time
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+from rlcore.atomic import write_json
+from rlcore.errors import UserError
+
+SWEEPS_DIR = Path("sweeps")
+SWEEP_FILE = "sweep.json"
+STOP_FILE = "STOP"
+
+
+@dataclass
+class Sweep:
+    """What a sweep runs: every combination of ``seeds`` and the ``grid`` values, on top of a preset."""
+    experiment: str
+    algo: str
+    name: str
+    folder: str  # absolute path of sweeps/<name>
+    seeds: list[int]
+    grid: dict[str, list] = field(default_factory=dict)  # hyperparameter -> values
+    preset: str | None = None
+    overrides: dict = field(default_factory=dict)  # budgets (max_env_steps, max_episodes)
+    cpus_per_run: float = 1.0
+    max_concurrent: int = 0  # 0 = as many as the CPUs allow
+    final_eval_episodes: int | None = None  # None = the experiment's default
+
+    def trials(self) -> list[dict]:
+        """One dict per trial: the seed and one value of every grid field."""
+        names = sorted(self.grid)
+        combos = itertools.product(*(self.grid[n] for n in names)) if names else [()]
+        return [{**dict(zip(names, values)), "seed": seed} for values in combos for seed in self.seeds]
+
+    def save(self) -> None:
+        write_json(Path(self.folder) / SWEEP_FILE, asdict(self))
+
+    @classmethod
+    def load(cls, folder: Path) -> "Sweep":
+        path = Path(folder) / SWEEP_FILE
+        if not path.is_file():
+            raise UserError(f"no sweep to resume in {folder} (no {SWEEP_FILE}); start it without --resume")
+        return cls(**json.loads(path.read_text()))
+
+
+def trial_name(trial: dict) -> str:
+    """``lr=0.0001__seed=3``: the grid values in name order, the seed last."""
+    parts = [f"{k}={trial[k]}" for k in sorted(trial) if k != "seed"] + [f"seed={trial['seed']}"]
+    return "__".join(parts)
+
+
+def parse_seeds(text: str) -> list[int]:
+    """``0-4`` or ``0,3,7`` (or both: ``0-2,9``)."""
+    from rlcore.seeding import MAX_RUN_SEED
+
+    seeds = []
+    for part in text.split(","):
+        part = part.strip()
+        try:
+            if "-" in part:
+                low, high = (int(x) for x in part.split("-", 1))
+                seeds.extend(range(low, high + 1))
+            elif part:
+                seeds.append(int(part))
+        except ValueError:
+            raise UserError(f"--seeds {text!r} is invalid: give a range (0-4) or a list (0,3,7)") from None
+    if not seeds or min(seeds) < 0 or max(seeds) > MAX_RUN_SEED or len(set(seeds)) != len(seeds):
+        raise UserError(f"--seeds {text!r} is invalid: allowed are distinct whole numbers from 0 to {MAX_RUN_SEED}")
+    return seeds
+
+
+def parse_grid(items: list[str], config) -> dict[str, list]:
+    """``["lr=1e-4,3e-4", "world=1,2"]`` -> ``{"lr": [0.0001, 0.0003], "world": [1, 2]}``, each value
+    parsed by its field's type; an unknown name is a :class:`UserError`."""
+    from rlcore.hparams import field_types
+
+    types = field_types(type(config))
+    grid = {}
+    for item in items:
+        name, sep, values = item.partition("=")
+        name = name.strip().lstrip("-").replace("-", "_")
+        if not sep or not values.strip():
+            raise UserError(f"--grid {item!r} is invalid: write NAME=V1,V2 (e.g. --grid lr=1e-4,3e-4)")
+        if name not in types:
+            raise UserError(f"--grid {item!r}: {name!r} is not a hyperparameter of {type(config).__name__}; "
+                            f"`main.py train EXPERIMENT ALGO --help` lists them")
+        try:
+            # tuple fields (hidden sizes) take ';' between values: --grid hidden=64,64;128,128
+            sep_values = values.split(";") if isinstance(getattr(config, name), tuple) else values.split(",")
+            grid[name] = [types[name](v.strip()) for v in sep_values if v.strip()]
+        except ValueError as exc:
+            raise UserError(f"--grid {item!r} is invalid: {exc}") from None
+    return grid
+
+
+def check(sweep: Sweep) -> None:
+    """Build every trial's config once, so a bad value stops the sweep before Ray starts."""
+    from rlcore.experiment import get_experiment
+    from rlcore.hparams import apply_overrides
+
+    exp = get_experiment(sweep.experiment)
+    base = exp.preset(sweep.algo, sweep.preset)
+    for trial in sweep.trials():
+        values = {k: v for k, v in trial.items() if k != "seed"}
+        apply_overrides(base, {**sweep.overrides, **values})
+
+
+# ------------------------------------------------------------------------------------- the trial
+def run_trial(trial: dict, sweep: dict, modules: dict, report) -> dict:
+    """Run (or resume, or skip if finished) one trial's run folder; ``report(metrics)`` is Tune's.
+
+    Returns the final metrics: the evaluation on unseen seeds from ``meta.json``.
+    """
+    from rlcore import experiment as registry
+
+    registry.EXPERIMENT_MODULES.update(modules)  # experiments registered by the caller (tests' toys)
+    sweep = Sweep(**sweep)
+    run_dir = Path(sweep.folder) / trial_name(trial)
+    meta_path = run_dir / "model" / "meta.json"
+    if meta_path.is_file():  # finished before: not run again
+        return final_metrics(json.loads(meta_path.read_text()), skipped=True)
+    run_dir.mkdir(parents=True, exist_ok=True)
+    (run_dir / "worker.pid").write_text(f"{os.getpid()}\n")
+
+    from rlcore import shipping
+    from rlcore.run import build_spec, run_training
+    from rlcore.trainers.session import Interrupted
+
+    resume = (run_dir / "checkpoint.npz").is_file()
+    values = {k: v for k, v in trial.items() if k != "seed"}
+    command = (f"python main.py sweep {sweep.experiment} {sweep.algo} --name {sweep.name} "
+               f"(trial {trial_name(trial)}{', resumed' if resume else ''})")
+    spec = build_spec(sweep.experiment, sweep.algo, preset=sweep.preset, seed=int(trial["seed"]),
+                      overrides={**sweep.overrides, **values}, run_dir=run_dir, resume=resume,
+                      wandb_mode="off", progress=False, command=command)
+    spec.stop_file = Path(sweep.folder) / STOP_FILE
+    last = [0.0]
+
+    def on_progress(row: dict, table: str) -> None:
+        now = time.monotonic()
+        if table != "metrics" or now - last[0] >= 1.0:  # episodes at most once a second
+            last[0] = now
+            report({f"{table}/{k}" if table != "metrics" else k: v for k, v in row.items()
+                    if isinstance(v, (int, float)) and not isinstance(v, bool)})
+    try:
+        model_dir = run_training(spec, on_progress)
+    except Interrupted:
+        return {"interrupted": 1}
+    episodes = shipping.eval_episodes(spec.experiment, sweep.final_eval_episodes)
+    meta = (shipping.evaluate_into_meta(model_dir, episodes) if episodes > 0
+            else json.loads((model_dir / "meta.json").read_text()))
+    return final_metrics(meta)
+
+
+def final_metrics(meta: dict, skipped: bool = False) -> dict:
+    ev = meta.get("evaluation") or {}
+    score = ev.get("success_share", ev.get("mean"))
+    return {"final_score": float("nan") if score is None else float(score), "env_steps": meta["env_steps"],
+            "wall_seconds": meta["wall_seconds"], "finished": 1, "skipped": int(skipped)}
+
+
+def _trainable(config: dict, sweep: dict, modules: dict, threads: int):
+    os.environ["TF_NUM_INTRAOP_THREADS"] = str(threads)  # TensorFlow is not loaded yet in this worker
+    os.environ["TF_NUM_INTEROP_THREADS"] = "1"
+    from ray import tune
+
+    final = run_trial(config, sweep, modules, tune.report)
+    tune.report(final)
+
+
+# ----------------------------------------------------------------------------------------- Ray
+def start_ray(address: str | None, num_cpus: int | None) -> bool:
+    """Start local Ray on 127.0.0.1 (or join ``address``). Returns whether this call started it."""
+    os.environ.setdefault("RAY_USAGE_STATS_ENABLED", "0")  # never phone home
+    if not address:
+        # Seen with Ray 2.60: without this variable its services also listen on the machine's network
+        # address; with it every socket stays on loopback. Local Ray only, never when joining a cluster.
+        os.environ["RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER"] = "0"
+    import ray
+
+    if ray.is_initialized():
+        return False
+    project_root = str(Path(__file__).resolve().parents[1])
+    runtime_env = {"env_vars": {"PYTHONPATH": project_root, "RAY_USAGE_STATS_ENABLED": "0",
+                                "TF_CPP_MIN_LOG_LEVEL": "3"}}
+    if address:
+        ray.init(address=address, runtime_env=runtime_env, log_to_driver=False)
+        return True
+    ray.init(num_cpus=num_cpus or os.cpu_count(), include_dashboard=False, _node_ip_address="127.0.0.1",
+             runtime_env=runtime_env, log_to_driver=False, configure_logging=False)
+    return True
+
+
+def run_sweep(sweep: Sweep, address: str | None = None, num_cpus: int | None = None) -> list[dict]:
+    """Run every unfinished trial of ``sweep`` on Ray Tune; return one result row per trial."""
+    from rlcore import experiment as registry
+
+    check(sweep)
+    folder = Path(sweep.folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    sweep.save()
+    (folder / STOP_FILE).unlink(missing_ok=True)
+    os.environ["TUNE_DISABLE_SIGINT_HANDLER"] = "1"  # our handler: stop trials at a checkpoint
+    os.environ.setdefault("RAY_AIR_NEW_OUTPUT", "0")
+    started = start_ray(address, num_cpus)
+    from ray import tune
+
+    def on_sigint(signum, frame):
+        (folder / STOP_FILE).touch()
+        print("\nCtrl-C: every running trial stops at its next checkpoint; --resume continues the sweep",
+              file=sys.stderr)
+    previous = signal.signal(signal.SIGINT, on_sigint)
+    try:
+        trainable = tune.with_parameters(_trainable, sweep=asdict(sweep), modules=dict(registry.EXPERIMENT_MODULES),
+                                         threads=max(1, int(sweep.cpus_per_run)))
+        space = {"seed": tune.grid_search(sweep.seeds),
+                 **{name: tune.grid_search(values) for name, values in sweep.grid.items()}}
+        tuner = tune.Tuner(
+            tune.with_resources(trainable, {"cpu": sweep.cpus_per_run}), param_space=space,
+            tune_config=tune.TuneConfig(max_concurrent_trials=sweep.max_concurrent or None),
+            run_config=tune.RunConfig(name="tune", storage_path=str((folder / "_tune").resolve()), verbose=0,
+                                      failure_config=tune.FailureConfig(max_failures=3)))
+        grid = tuner.fit()
+    finally:
+        signal.signal(signal.SIGINT, previous)
+        if started:
+            import ray
+            ray.shutdown()
+    rows = []
+    for result in grid:
+        metrics = result.metrics or {}
+        rows.append({"trial": trial_name({k: v for k, v in result.config.items()}),
+                     "error": str(result.error).splitlines()[0] if result.error else None, **metrics})
+    return rows

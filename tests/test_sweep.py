@@ -1,0 +1,163 @@
+"""Sweeps on a local Ray (2 CPUs, 127.0.0.1, one instance for this module): trials run to the end,
+survive a SIGKILL of their worker, stop at a checkpoint on Ctrl-C, resume without re-running
+finished trials; the report's statistics against direct computations."""
+import json
+import os
+import signal
+import subprocess
+import threading
+import time
+
+import numpy as np
+import pytest
+
+from rlcore import experiment as registry
+from rlcore.checkpoint import read_checkpoint_state
+from rlcore.report import aggregates, load_runs, probability_of_improvement, stratified_bootstrap_ci, summarize
+from rlcore.sweep import STOP_FILE, Sweep, parse_grid, parse_seeds, run_sweep, start_ray
+from tests.test_cli import run
+
+BUDGET = {"max_episodes": 40, "stop_score": 99.0, "checkpoint_every": 10}
+
+
+@pytest.fixture(scope="module")
+def local_ray():
+    registry.EXPERIMENT_MODULES["toy"] = "tests.toy"  # trials get the registry from the driver
+    start_ray(None, 2)
+    yield
+    import ray
+    ray.shutdown()
+    registry.EXPERIMENT_MODULES.pop("toy", None)
+
+
+def _sweep(tmp_path, name, seeds=(0, 1), **budget):
+    return Sweep("toy", "dqn", name, str(tmp_path / name), list(seeds), {}, None, {**BUDGET, **budget},
+                 1.0, 0, 5)
+
+
+def _ray_sockets():
+    out = subprocess.run(["ss", "-tnlpH"], capture_output=True, text=True).stdout
+    return [line for line in out.splitlines() if any(p in line for p in ("raylet", "gcs_server", "ray::"))]
+
+
+def _wait_for(path, timeout=120):
+    deadline = time.monotonic() + timeout
+    while not path.exists():
+        assert time.monotonic() < deadline, f"{path} never appeared"
+        time.sleep(0.02)
+
+
+def test_local_ray_listens_on_loopback_only(local_ray):
+    sockets = _ray_sockets()
+    assert sockets, "no Ray service found listening"
+    loopback = ("127.0.0.1", "[::ffff:127.0.0.1]", "[::1]")
+    outside = [s for s in sockets if s.split()[3].rsplit(":", 1)[0] not in loopback]
+    assert not outside, outside
+
+
+def test_a_two_seed_sweep_runs_to_the_end_and_its_report_matches_the_run_folders(local_ray, tmp_path):
+    sweep = _sweep(tmp_path, "two")
+    rows = run_sweep(sweep)
+    assert sorted(r["trial"] for r in rows) == ["seed=0", "seed=1"]
+    assert all(r["error"] is None and r["finished"] == 1 for r in rows), rows
+    metas = [json.loads((tmp_path / "two" / t / "model" / "meta.json").read_text()) for t in ("seed=0", "seed=1")]
+    assert [m["seed"] for m in metas] == [0, 1] and all(m["evaluation"]["episodes"] == 5 for m in metas)
+    scores = np.array([[m["evaluation"]["mean"]] for m in metas])
+    result = summarize([tmp_path / "two"], reps=500)
+    (mean, median, iqm) = (result["sweeps"][0]["aggregates"][k][0] for k in ("mean", "median", "iqm"))
+    assert mean == pytest.approx(scores.mean()) and median == pytest.approx(np.median(scores))
+    assert iqm == pytest.approx(aggregates(scores)[2])
+    assert [r["env_steps"] for r in load_runs(tmp_path / "two")] == [m["env_steps"] for m in metas]
+
+
+def test_a_killed_trial_resumes_from_its_checkpoint(local_ray, tmp_path):
+    sweep = _sweep(tmp_path, "kill", seeds=(0,), max_episodes=400, checkpoint_every=5)
+    trial = tmp_path / "kill" / "seed=0"
+    killed = {}
+
+    def killer():
+        _wait_for(trial / "checkpoint.npz")
+        _wait_for(trial / "worker.pid")
+        killed["pid"] = int((trial / "worker.pid").read_text())
+        os.kill(killed["pid"], signal.SIGKILL)
+    thread = threading.Thread(target=killer, daemon=True)
+    thread.start()
+    rows = run_sweep(sweep)
+    thread.join(5)
+    assert killed and rows[0]["error"] is None, rows
+    meta = json.loads((trial / "model" / "meta.json").read_text())
+    assert len(meta["commands"]) == 2 and meta["commands"][1].endswith("resumed)"), meta["commands"]
+    assert int((trial / "worker.pid").read_text()) != killed["pid"]
+    episodes = [int(line.split(",")[0]) for line in (trial / "metrics.csv").read_text().splitlines()[1:]]
+    assert episodes == list(range(1, len(episodes) + 1)) and len(episodes) >= 400
+
+
+def test_ctrl_c_stops_at_a_checkpoint_and_resume_skips_finished_trials(local_ray, tmp_path):
+    sweep = _sweep(tmp_path, "stop", seeds=(0,), max_episodes=4000, checkpoint_every=5)
+    trial = tmp_path / "stop" / "seed=0"
+
+    def ctrl_c():
+        _wait_for(trial / "checkpoint.npz")
+        os.kill(os.getpid(), signal.SIGINT)  # the sweep's handler writes STOP
+    threading.Thread(target=ctrl_c, daemon=True).start()
+    rows = run_sweep(sweep)
+    assert rows[0].get("interrupted") == 1, rows
+    assert (tmp_path / "stop" / STOP_FILE).exists() and not (trial / "model").exists()
+    stopped_at = read_checkpoint_state(trial / "checkpoint.npz")["env_steps"]
+    # --resume (budget lowered so the run ends at once): the trial continues from its checkpoint
+    resumed = Sweep.load(tmp_path / "stop")
+    resumed.overrides = {**resumed.overrides, "max_episodes": 1}
+    rows = run_sweep(resumed)
+    meta = json.loads((trial / "model" / "meta.json").read_text())
+    assert meta["env_steps"] >= stopped_at and rows[0]["skipped"] == 0
+    finished_mtime = (trial / "model" / "meta.json").stat().st_mtime
+    rows = run_sweep(Sweep.load(tmp_path / "stop"))
+    assert rows[0]["skipped"] == 1
+    assert (trial / "model" / "meta.json").stat().st_mtime == finished_mtime
+
+
+def test_no_ray_process_is_left_behind(local_ray):
+    import ray
+    ray.shutdown()
+    deadline = time.monotonic() + 20
+    while _ray_sockets() and time.monotonic() < deadline:
+        time.sleep(0.2)
+    assert not _ray_sockets()
+    left = subprocess.run(["pgrep", "-f", "raylet|gcs_server"], capture_output=True, text=True).stdout
+    assert not left.strip(), left
+
+
+# ------------------------------------------------------------------------- without Ray
+def test_bootstrap_ci_on_known_answers():
+    constant = np.full((8, 1), 3.0)
+    point, ci = stratified_bootstrap_ci(aggregates, constant, reps=200)
+    np.testing.assert_allclose(point, 3.0) and np.testing.assert_allclose(ci, 3.0)
+    scores = np.arange(1.0, 101.0)[:, None]
+    point, ci = stratified_bootstrap_ci(aggregates, scores, reps=2000)
+    np.testing.assert_allclose(point, [50.5, 50.5, 50.5])
+    # the mean of 1..100 has standard error 29.01 / 10: the 95% interval is about 50.5 +- 5.7
+    assert ci[0][0] == pytest.approx(50.5 - 5.7, abs=0.8) and ci[1][0] == pytest.approx(50.5 + 5.7, abs=0.8)
+    assert probability_of_improvement(scores + 1000, scores) == 1.0
+    assert probability_of_improvement(scores, scores) == pytest.approx(0.5)
+
+
+def test_seeds_and_grid_parsing():
+    from rlcore.configs import DQNConfig
+
+    assert parse_seeds("0-4") == [0, 1, 2, 3, 4] and parse_seeds("0,3,7") == [0, 3, 7]
+    assert parse_grid(["lr=1e-4,3e-4", "hidden=64,64;128"], DQNConfig()) == {
+        "lr": [1e-4, 3e-4], "hidden": [(64, 64), (128,)]}
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["sweep", "lunar_lander", "dqn", "--grid", "learning_rate=1e-3"], "'learning_rate' is not a hyperparameter"),
+    (["sweep", "lunar_lander", "dqn", "--grid", "gamma=0.9,1.5"], "--gamma 1.5 is invalid"),
+    (["sweep", "lunar_lander", "dqn", "--grid", "lr=fast"], "--grid 'lr=fast' is invalid"),
+    (["sweep", "lunar_lander", "dqn", "--seeds", "4-x"], "--seeds '4-x' is invalid"),
+    (["report", "/nonexistent/sweep"], "no sweep folder /nonexistent/sweep"),
+])
+def test_bad_sweep_values_are_one_line_and_exit_2(capsys, tmp_path, monkeypatch, argv, message):
+    monkeypatch.chdir(tmp_path)
+    code, out, err = run(capsys, *argv, "--name", "x") if argv[0] == "sweep" else run(capsys, *argv)
+    assert code == 2 and message in err and len(err.strip().splitlines()) == 1, err
+    assert not (tmp_path / "sweeps").exists()
