@@ -34,6 +34,7 @@ benchmark: $(STAMP)
 	$(PY) benchmarks/cartpole.py --train a2c
 	$(PY) benchmarks/mario.py
 	$(PY) benchmarks/minitaur.py
+	$(PY) benchmarks/sweep.py
 
 # Commit the checkpoints and CSV tables of the runs under long_runs/ (before every stop of a session).
 save-long-runs:

@@ -24,6 +24,7 @@ NOISE = re.compile("|".join([
     r"^E0000 .*cuda_executor\.cc:\d+\] failed call to cuInit",
     r"^argv\[0\]=$",
     r"^pybullet build time: ",
+    r"^Token authentication is enabled for this Ray cluster\.",  # local Ray keeps its token; no news
 ]))
 
 

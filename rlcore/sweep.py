@@ -208,8 +208,10 @@ def start_ray(address: str | None, num_cpus: int | None) -> bool:
     if address:
         ray.init(address=address, runtime_env=runtime_env, log_to_driver=False)
         return True
-    ray.init(num_cpus=num_cpus or os.cpu_count(), include_dashboard=False, _node_ip_address="127.0.0.1",
-             runtime_env=runtime_env, log_to_driver=False, configure_logging=False)
+    from rlcore.quiet import filtered_stderr
+    with filtered_stderr():
+        ray.init(num_cpus=num_cpus or os.cpu_count(), include_dashboard=False, _node_ip_address="127.0.0.1",
+                 runtime_env=runtime_env, log_to_driver=False, configure_logging=False)
     return True
 
 
@@ -239,7 +241,9 @@ def run_sweep(sweep: Sweep, address: str | None = None, num_cpus: int | None = N
                  **{name: tune.grid_search(values) for name, values in sweep.grid.items()}}
         tuner = tune.Tuner(
             tune.with_resources(trainable, {"cpu": sweep.cpus_per_run}), param_space=space,
-            tune_config=tune.TuneConfig(max_concurrent_trials=sweep.max_concurrent or None),
+            # reuse_actors: a worker loads TensorFlow once, not once per trial (4 toy trials on 2
+            # CPUs: 25.6 s against 60.8 s here, measured beside a training)
+            tune_config=tune.TuneConfig(max_concurrent_trials=sweep.max_concurrent or None, reuse_actors=True),
             run_config=tune.RunConfig(name="tune", storage_path=str((folder / "_tune").resolve()), verbose=0,
                                       failure_config=tune.FailureConfig(max_failures=3)))
         grid = tuner.fit()
