@@ -20,6 +20,8 @@ NOISE = re.compile("|".join([
     r"^WARNING: All log messages before absl::InitializeLog\(\) is called are written to STDERR$",
     r"^I0000 .*port\.cc:\d+\] oneDNN custom operations are on",
     r"^I0000 .*cudart_stub\.cc:\d+\] Could not find cuda drivers",
+    r"^I0000 .*cpu_feature_guard\.cc:\d+\] This TensorFlow binary is optimized",
+    r"^To enable the following instructions: .*rebuild TensorFlow with the appropriate compiler flags\.$",
     r"^E0000 .*cuda_platform\.cc:\d+\] failed call to cuInit",
     r"^E0000 .*cuda_executor\.cc:\d+\] failed call to cuInit",
     r"^argv\[0\]=$",
