@@ -25,6 +25,7 @@ from rlcore.hparams import to_dict
 from rlcore.plotting import plot_run
 from rlcore.tracking import Tracker
 from rlcore.trainers.episodes import EpisodeBook
+from rlcore.trainers.periodic_eval import PeriodicEvaluation
 
 RUNS_DIR = Path("runs")
 CHECKPOINT_FILE = "checkpoint.npz"
@@ -113,13 +114,7 @@ class TrainingSession:
         self._started = time.perf_counter()
         self._steps_at_start = self.env_steps
         self.stop_requested = False
-        self.best_eval = state.get("best_eval")  # {"mean", "std", "env_steps"} of the best evaluation
-        self.best_weights = None  # snapshot of the best evaluation's weights (keep_best)
-        # periodic greedy evaluations: only the episode-driven configs (EpisodeLoop) have them
-        self.eval_every = getattr(cfg, "eval_every_steps", 0)
-        self.keep_best = getattr(cfg, "keep_best", False)
-        self.stop_eval_score = getattr(cfg, "stop_eval_score", 0.0)
-        self.next_eval_step = int(state.get("next_eval_step", self.eval_every))
+        self.evaluation = PeriodicEvaluation(cfg, state)
         # the command that started the run, then one per resume
         self.commands = list(state.get("commands", [])) + [spec.command]
         self.tracker = Tracker(self.run_dir, self.run_dir.name, self.describe(), spec.wandb_mode,
@@ -167,27 +162,13 @@ class TrainingSession:
             self.progress.update(steps)
 
     def maybe_evaluate(self, greedy_policy, snapshot) -> None:
-        """Every ``eval_every_steps`` env steps: greedy episodes on the fixed selection seeds.
+        """When due, a periodic greedy evaluation (:class:`PeriodicEvaluation`), logged to evals.csv.
 
-        ``greedy_policy(obs_batch) -> actions``; ``snapshot() -> weights`` is kept for the best
-        evaluation when ``keep_best`` is set.
+        ``greedy_policy(obs_batch) -> actions``; ``snapshot() -> weights`` of the model now.
         """
-        cfg, exp = self.spec.config, self.spec.experiment
-        if not self.eval_every or self.env_steps < self.next_eval_step:
-            return
-        while self.next_eval_step <= self.env_steps:
-            self.next_eval_step += self.eval_every
-        from rlcore.evaluation import evaluate
-
-        returns = evaluate(exp, greedy_policy, cfg.eval_episodes, seed_base=exp.selection_seed_base,
-                           max_episode_steps=cfg.max_episode_steps or None, progress=False)
-        mean, std = float(returns.mean()), float(returns.std())
-        self.tracker.log({"env_steps": self.env_steps, "episode": self.book.episodes,
-                          "eval_mean": mean, "eval_std": std}, table="evals")
-        if self.best_eval is None or mean >= self.best_eval["mean"]:
-            self.best_eval = {"mean": round(mean, 2), "std": round(std, 2), "env_steps": self.env_steps}
-            if self.keep_best:
-                self.best_weights = snapshot()
+        if self.evaluation.due(self.env_steps):
+            row = self.evaluation.run(self.spec.experiment, greedy_policy, snapshot, self.env_steps)
+            self.tracker.log({"env_steps": self.env_steps, "episode": self.book.episodes, **row}, table="evals")
 
     def should_stop(self) -> bool:
         cfg = self.spec.config
@@ -199,7 +180,7 @@ class TrainingSession:
             return True
         if cfg.max_env_steps and self.env_steps >= cfg.max_env_steps:
             return True
-        if self.stop_eval_score and self.best_eval and self.best_eval["mean"] >= self.stop_eval_score:
+        if self.evaluation.reached_stop_score():
             return True
         return self.book.full_window() and self.book.average >= cfg.stop_score
 
@@ -207,18 +188,14 @@ class TrainingSession:
         """JSON-able counters for a checkpoint."""
         return {**self.describe(), "returns": self.book.returns, "solved_episode": self.book.solved_episode,
                 "env_steps": self.env_steps, "wall_seconds": self.elapsed(),
-                "wandb_id": self.tracker.wandb_id, "best_eval": self.best_eval,
-                "next_eval_step": self.next_eval_step, "commands": self.commands, **extra}
+                "wandb_id": self.tracker.wandb_id, **self.evaluation.state(), "commands": self.commands,
+                **extra}
 
     def best_arrays(self) -> dict:
-        """The kept best weights, as checkpoint arrays."""
-        if self.best_weights is None:
-            return {}
-        return {f"best/{i}": w for i, w in enumerate(self.best_weights)}
+        return self.evaluation.best_arrays()
 
     def restore_best_arrays(self, arrays: dict) -> None:
-        keys = sorted((k for k in arrays if k.startswith("best/")), key=lambda k: int(k.split("/")[1]))
-        self.best_weights = [arrays[k] for k in keys] or None
+        self.evaluation.restore_best_arrays(arrays)
 
     @property
     def checkpoint_path(self) -> Path:
@@ -251,9 +228,9 @@ class TrainingSession:
         """
         self.progress.close()
         self.tracker.close()
-        kept_best = self.keep_best and self.best_weights is not None
+        kept_best = self.evaluation.keep_best and self.evaluation.best_weights is not None
         if kept_best:
-            load_weights(self.best_weights)
+            load_weights(self.evaluation.best_weights)
         model_dir = self.run_dir / "model"
         model_dir.mkdir(parents=True, exist_ok=True)
         files = [p.name for p in save_models(model_dir)]
@@ -266,7 +243,7 @@ class TrainingSession:
                 "solved_episode": self.book.solved_episode,
                 "final_average": round(self.book.average, 2), "model_files": files,
                 "weights": "best periodic evaluation" if kept_best else "last",
-                "best_eval": self.best_eval,
+                "best_eval": self.evaluation.best,
                 "plot": plot_name, "versions": package_versions(),
                 "finished": datetime.now(timezone.utc).isoformat(timespec="seconds")}
         write_json(model_dir / "meta.json", meta)
