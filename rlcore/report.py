@@ -95,19 +95,28 @@ def learning_curve(run_dirs: list[Path], points: int = 40) -> tuple[np.ndarray, 
 
 
 # --------------------------------------------------------------------------------------- report
+def setting_of(trial: str) -> str:
+    """``lr=0.0001__seed=3`` -> ``lr=0.0001``: the grid values, which group runs across seeds."""
+    return "__".join(part for part in trial.split("__") if not part.startswith("seed="))
+
+
 def summarize(sweep_dirs: list[Path], reps: int = 5000) -> dict:
-    """Everything ``main.py report`` prints, as numbers."""
-    sweeps = []
+    """Everything ``main.py report`` prints, as numbers: one group per sweep and grid setting."""
+    groups = []
     for folder in sweep_dirs:
         runs = load_runs(folder)
-        scores = np.array([[r["score"]] for r in runs])
-        point, ci = stratified_bootstrap_ci(aggregates, scores, reps=reps)
-        sweeps.append({"folder": Path(folder), "runs": runs,
-                       "aggregates": {name: (float(point[i]), float(ci[0][i]), float(ci[1][i]))
-                                      for i, name in enumerate(AGGREGATES)}})
-    result = {"sweeps": sweeps}
-    if len(sweeps) == 2:
-        x, y = (np.array([[r["score"]] for r in s["runs"]]) for s in sweeps)
+        settings = sorted({setting_of(r["trial"]) for r in runs})
+        for setting in settings:
+            members = [r for r in runs if setting_of(r["trial"]) == setting]
+            scores = np.array([[r["score"]] for r in members])
+            point, ci = stratified_bootstrap_ci(aggregates, scores, reps=reps)
+            label = Path(folder).name + (f" [{setting}]" if setting else "")
+            groups.append({"folder": Path(folder), "label": label, "runs": members,
+                           "aggregates": {name: (float(point[i]), float(ci[0][i]), float(ci[1][i]))
+                                          for i, name in enumerate(AGGREGATES)}})
+    result = {"sweeps": groups}
+    if len(groups) == 2:
+        x, y = (np.array([[r["score"]] for r in g["runs"]]) for g in groups)
         point, ci = stratified_bootstrap_ci(lambda a, b: probability_of_improvement(a, b), x, y, reps=reps)
         result["probability_of_improvement"] = (float(point), float(ci[0]), float(ci[1]))
     return result
@@ -116,7 +125,7 @@ def summarize(sweep_dirs: list[Path], reps: int = 5000) -> dict:
 def markdown(result: dict) -> str:
     lines = []
     for s in result["sweeps"]:
-        lines += [f"## {s['folder']}", "", "| run | seed | final score (unseen seeds) | env steps | wall |",
+        lines += [f"## {s['label']} ({s['folder']})", "", "| run | seed | final score (unseen seeds) | env steps | wall |",
                   "| --- | ---: | ---: | ---: | ---: |"]
         lines += [f"| {r['trial']} | {r['seed']} | {r['score']:.3f} | {r['env_steps']:,} | {r['wall_seconds']:.0f} s |"
                   for r in s["runs"]]
@@ -125,7 +134,7 @@ def markdown(result: dict) -> str:
         lines.append("")
     if "probability_of_improvement" in result:
         p, lo, hi = result["probability_of_improvement"]
-        first, second = (s["folder"] for s in result["sweeps"])
+        first, second = (s["label"] for s in result["sweeps"])
         lines += [f"P({first} > {second}) = {p:.3f} [{lo:.3f}, {hi:.3f}]", ""]
     return "\n".join(lines)
 
@@ -147,7 +156,7 @@ def plot_curves(result: dict, out: Path, reps: int = 1000) -> Path:
             iqm.append(float(point))
             low.append(float(ci[0]))
             high.append(float(ci[1]))
-        ax.plot(grid, iqm, label=f"{s['folder'].name} (IQM of {len(s['runs'])} runs)")
+        ax.plot(grid, iqm, label=f"{s['label']} (IQM of {len(s['runs'])} runs)")
         ax.fill_between(grid, low, high, alpha=0.25)
     ax.set_xlabel("env steps")
     ax.set_ylabel("100-episode average return")

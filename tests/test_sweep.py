@@ -161,3 +161,21 @@ def test_bad_sweep_values_are_one_line_and_exit_2(capsys, tmp_path, monkeypatch,
     code, out, err = run(capsys, *argv, "--name", "x") if argv[0] == "sweep" else run(capsys, *argv)
     assert code == 2 and message in err and len(err.strip().splitlines()) == 1, err
     assert not (tmp_path / "sweeps").exists()
+
+
+def test_report_groups_a_grid_sweep_by_setting(tmp_path):
+    from rlcore.report import markdown
+
+    for lr, scores in (("0.001", (1.0, 2.0, 3.0)), ("0.01", (7.0, 8.0, 9.0))):
+        for seed, score in enumerate(scores):
+            model = tmp_path / "grid" / f"lr={lr}__seed={seed}" / "model"
+            model.mkdir(parents=True)
+            (model / "meta.json").write_text(json.dumps({
+                "seed": seed, "env_steps": 100, "wall_seconds": 1.0,
+                "evaluation": {"episodes": 5, "mean": score}}))
+    result = summarize([tmp_path / "grid"], reps=200)
+    labels = [g["label"] for g in result["sweeps"]]
+    assert labels == ["grid [lr=0.001]", "grid [lr=0.01]"]
+    assert [g["aggregates"]["mean"][0] for g in result["sweeps"]] == [2.0, 8.0]
+    assert result["probability_of_improvement"][0] == 0.0  # every lr=0.001 run below every lr=0.01 run
+    assert "P(grid [lr=0.001] > grid [lr=0.01]) = 0.000" in markdown(result)
