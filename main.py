@@ -178,7 +178,8 @@ def cmd_sweep(args) -> int:
     if args.resume:
         sweep = Sweep.load(folder)
         if (sweep.experiment, sweep.algo) != (args.experiment, args.algo):
-            raise UserError(f"sweep {name} runs {sweep.experiment} {sweep.algo}, not {args.experiment} {args.algo}")
+            raise UserError(f"sweep {name} runs {sweep.experiment} {sweep.algo}, "
+                            f"not {args.experiment} {args.algo}")
     else:
         if (folder / "sweep.json").exists():
             raise UserError(f"sweep {name} exists in {folder}; continue it with --resume or pick another --name")
@@ -199,7 +200,8 @@ def cmd_sweep(args) -> int:
         elif row.get("interrupted"):
             status = "stopped at a checkpoint (--resume continues it)"
         else:
-            status = (f"final score {row.get('final_score', float('nan')):.3f}, {row.get('env_steps', 0):,} env steps"
+            status = (f"final score {row.get('final_score', float('nan')):.3f}, "
+                      f"{row.get('env_steps', 0):,} env steps"
                       + (" (finished earlier)" if row.get("skipped") else ""))
         print(f"  {row['trial']}: {status}")
     print(f"report: python main.py report {folder}")

@@ -125,11 +125,13 @@ def summarize(sweep_dirs: list[Path], reps: int = 5000) -> dict:
 def markdown(result: dict) -> str:
     lines = []
     for s in result["sweeps"]:
-        lines += [f"## {s['label']} ({s['folder']})", "", "| run | seed | final score (unseen seeds) | env steps | wall |",
+        lines += [f"## {s['label']} ({s['folder']})", "",
+                  "| run | seed | final score (unseen seeds) | env steps | wall |",
                   "| --- | ---: | ---: | ---: | ---: |"]
-        lines += [f"| {r['trial']} | {r['seed']} | {r['score']:.3f} | {r['env_steps']:,} | {r['wall_seconds']:.0f} s |"
-                  for r in s["runs"]]
-        lines += ["", f"| over {len(s['runs'])} runs | point | 95% CI (stratified bootstrap) |", "| --- | ---: | --- |"]
+        lines += [f"| {r['trial']} | {r['seed']} | {r['score']:.3f} | {r['env_steps']:,} "
+                  f"| {r['wall_seconds']:.0f} s |" for r in s["runs"]]
+        lines += ["", f"| over {len(s['runs'])} runs | point | 95% CI (stratified bootstrap) |",
+                  "| --- | ---: | --- |"]
         lines += [f"| {name} | {p:.3f} | [{lo:.3f}, {hi:.3f}] |" for name, (p, lo, hi) in s["aggregates"].items()]
         lines.append("")
     if "probability_of_improvement" in result:

@@ -87,7 +87,8 @@ def parse_seeds(text: str) -> list[int]:
         except ValueError:
             raise UserError(f"--seeds {text!r} is invalid: give a range (0-4) or a list (0,3,7)") from None
     if not seeds or min(seeds) < 0 or max(seeds) > MAX_RUN_SEED or len(set(seeds)) != len(seeds):
-        raise UserError(f"--seeds {text!r} is invalid: allowed are distinct whole numbers from 0 to {MAX_RUN_SEED}")
+        raise UserError(f"--seeds {text!r} is invalid: allowed are distinct whole numbers from 0 to "
+                        f"{MAX_RUN_SEED}")
     return seeds
 
 
@@ -235,7 +236,8 @@ def run_sweep(sweep: Sweep, address: str | None = None, num_cpus: int | None = N
               file=sys.stderr)
     previous = signal.signal(signal.SIGINT, on_sigint)
     try:
-        trainable = tune.with_parameters(_trainable, sweep=asdict(sweep), modules=dict(registry.EXPERIMENT_MODULES),
+        trainable = tune.with_parameters(_trainable, sweep=asdict(sweep),
+                                         modules=dict(registry.EXPERIMENT_MODULES),
                                          threads=max(1, int(sweep.cpus_per_run)))
         space = {"seed": tune.grid_search(sweep.seeds),
                  **{name: tune.grid_search(values) for name, values in sweep.grid.items()}}
