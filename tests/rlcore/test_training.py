@@ -69,20 +69,7 @@ def test_sac_learns_the_reach_task(tmp_path):
 def test_interrupt_then_resume_continues_the_counters(algo, tmp_path):
     extra = {"ppo": {"stop_success_share": 0.0}, "sac": {"max_env_steps": 0, "learning_starts": 100}}
     spec = toy.spec(algo, tmp_path, stop_score=99.0, max_episodes=30, **extra.get(algo, {}))
-    # Stop the run as Ctrl-C would, after 12 episodes.
-    from rlcore.trainers import session as session_mod
-    original = session_mod.TrainingSession.end_episode
-
-    def end_episode(self, episode_return, extra):
-        original(self, episode_return, extra)
-        if self.book.episodes == 12:
-            self.stop_requested = True
-    session_mod.TrainingSession.end_episode = end_episode
-    try:
-        with pytest.raises(Interrupted):
-            TRAINERS[algo].train(spec)
-    finally:
-        session_mod.TrainingSession.end_episode = original
+    _interrupt_after(12, TRAINERS[algo], spec)
     state = read_checkpoint_state(spec.run_dir / "checkpoint.npz")
     assert len(state["returns"]) >= 12 and state["env_steps"] > 0
     # A crash after the checkpoint leaves rows the checkpoint does not know; resume must drop them.
@@ -95,6 +82,23 @@ def test_interrupt_then_resume_continues_the_counters(algo, tmp_path):
     assert meta["env_steps"] > state["env_steps"]
     episodes = [int(line.split(",")[0]) for line in (model_dir / "metrics.csv").read_text().splitlines()[1:]]
     assert episodes == list(range(1, len(episodes) + 1)), "episode counter restarted or skipped"
+
+
+def _interrupt_after(episodes, trainer, spec):
+    """Train until ``episodes`` have ended, then stop as Ctrl-C would (checkpoint, Interrupted)."""
+    from rlcore.trainers import session as session_mod
+    original = session_mod.TrainingSession.end_episode
+
+    def end_episode(self, episode_return, extra):
+        original(self, episode_return, extra)
+        if self.book.episodes == episodes:
+            self.stop_requested = True
+    session_mod.TrainingSession.end_episode = end_episode
+    try:
+        with pytest.raises(Interrupted):
+            trainer.train(spec)
+    finally:
+        session_mod.TrainingSession.end_episode = original
 
 
 def _append_rows_after_checkpoint(csv_path, count):
@@ -197,19 +201,7 @@ def test_a_run_resumes_from_what_git_keeps_of_it(tmp_path):
     run_dir = repo / "long_runs" / "toy_image" / "ppo"
     spec = toy.spec("ppo", tmp_path, stop_score=99.0, max_episodes=30, stop_success_share=0.0)
     spec.run_dir, spec.wandb_mode = run_dir, "offline"
-    from rlcore.trainers import session as session_mod
-    original = session_mod.TrainingSession.end_episode
-
-    def end_episode(self, episode_return, extra):
-        original(self, episode_return, extra)
-        if self.book.episodes == 12:
-            self.stop_requested = True
-    session_mod.TrainingSession.end_episode = end_episode
-    try:
-        with pytest.raises(Interrupted):
-            ppo_trainer.train(spec)
-    finally:
-        session_mod.TrainingSession.end_episode = original
+    _interrupt_after(12, ppo_trainer, spec)
     assert (run_dir / "wandb").is_dir()
     shutil.copyfile(ROOT / ".gitignore", repo / ".gitignore")
     git("init", "-q", cwd=repo)
