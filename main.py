@@ -19,6 +19,8 @@ from pathlib import Path
 os.environ.setdefault("TF_CPP_MIN_LOG_LEVEL", "2")
 
 from rlcore import shipping  # noqa: E402  (TF-free)
+from rlcore import allowed  # noqa: E402
+from rlcore.allowed import Allowed, whole_number  # noqa: E402
 from rlcore.seeding import MAX_RUN_SEED  # noqa: E402
 from rlcore.errors import UserError  # noqa: E402
 
@@ -38,16 +40,18 @@ def cmd_list(args) -> int:
     return 0
 
 
+def _budget_overrides(args) -> dict:
+    """``--episodes`` / ``--steps`` as the config fields they set."""
+    budget = {"max_episodes": args.episodes, "max_env_steps": args.steps}
+    return {name: value for name, value in budget.items() if value is not None}
+
+
 def _spec_from_args(args):
     from rlcore.hparams import overrides_from_args
     from rlcore.run import build_spec
     from rlcore.trainers.session import latest_run_dir, new_run_dir
 
-    overrides = overrides_from_args(args)
-    if args.episodes is not None:
-        overrides["max_episodes"] = args.episodes
-    if args.steps is not None:
-        overrides["max_env_steps"] = args.steps
+    overrides = {**overrides_from_args(args), **_budget_overrides(args)}
     common = dict(preset=args.preset, seed=args.seed, overrides=overrides, wandb_mode=args.wandb,
                   progress=not args.no_progress)
     if args.resume is not None:
@@ -99,7 +103,10 @@ def _model_dir(args) -> Path:
         raise UserError(f"--world/--stage choose a Mario level; {exp.name} ships one model per algorithm")
     if args.model:
         raise UserError("give either --model or --world/--stage, not both")
-    folder = shipping.SAVED_NETWORKS / exp.name / f"{args.world or 1}-{args.stage or 1}"
+    from types import SimpleNamespace
+
+    folder = shipping.shipped_dir(exp.name, args.algo, SimpleNamespace(world=args.world or 1,
+                                                                       stage=args.stage or 1))
     if not (folder / "meta.json").is_file():
         shipped = sorted(p.parent.name for p in folder.parent.glob("*-*/meta.json"))
         raise UserError(f"no shipped model for level {folder.name}; shipped levels: {', '.join(shipped) or 'none'}"
@@ -183,13 +190,8 @@ def cmd_sweep(args) -> int:
     else:
         if (folder / "sweep.json").exists():
             raise UserError(f"sweep {name} exists in {folder}; continue it with --resume or pick another --name")
-        overrides = {}
-        if args.episodes is not None:
-            overrides["max_episodes"] = args.episodes
-        if args.steps is not None:
-            overrides["max_env_steps"] = args.steps
         sweep = Sweep(args.experiment, args.algo, name, str(folder), parse_seeds(args.seeds),
-                      parse_grid(args.grid, base), args.preset, overrides, args.cpus_per_run,
+                      parse_grid(args.grid, base), args.preset, _budget_overrides(args), args.cpus_per_run,
                       args.max_concurrent, args.final_eval_episodes)
     trials = sweep.trials()
     print(f"sweep {name}: {len(trials)} trials of {sweep.experiment} {sweep.algo} -> {folder}/")
@@ -230,22 +232,8 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"error: {message} (see `{self.prog} --help`)\n")
 
 
-def _whole_number(low: int, high: int | None = None):
-    """An argparse type: an integer in [low, high], refused with what is allowed."""
-    def parse(text: str) -> int:
-        try:
-            value = int(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
-        if value < low or (high is not None and value > high):
-            allowed = f"from {low} to {high}" if high is not None else f"of at least {low}"
-            raise argparse.ArgumentTypeError(f"{value} is invalid: allowed is a whole number {allowed}")
-        return value
-    return parse
-
-
-COUNT, NON_NEGATIVE = _whole_number(1), _whole_number(0)
-SEED = _whole_number(0, MAX_RUN_SEED)
+COUNT, NON_NEGATIVE = whole_number(allowed.COUNT), whole_number(allowed.NON_NEGATIVE)
+SEED = whole_number(Allowed(low=0, high=MAX_RUN_SEED))
 
 
 def build_parser(argv: list[str]) -> argparse.ArgumentParser:
@@ -301,7 +289,7 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
                            help="write the result into the model folder's meta.json as its evaluation")
         else:
             p.add_argument("--out", default=None, help="MP4 path (default videos/EXPERIMENT_ALGO.mp4)")
-            p.add_argument("--fps", type=_whole_number(1, 240), default=None,
+            p.add_argument("--fps", type=whole_number(Allowed(low=1, high=240)), default=None,
                            help="frames per second (default: experiment's)")
             p.add_argument("--episodes", type=COUNT, default=None, help="default 1; Minitaur 3")
             p.add_argument("--seed", type=NON_NEGATIVE, default=None,
@@ -324,7 +312,7 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
                        help="evaluation episodes on unseen seeds after each run (default 100; Mario 10)")
     sweep.add_argument("--max-concurrent", type=NON_NEGATIVE, default=0,
                        help="trials at once (default 0: as many as the CPUs allow)")
-    sweep.add_argument("--cpus-per-run", type=_whole_number(1, 256), default=1,
+    sweep.add_argument("--cpus-per-run", type=whole_number(Allowed(low=1, high=256)), default=1,
                        help="CPUs reserved per trial; TensorFlow's threads follow it (default 1)")
     sweep.add_argument("--num-cpus", type=COUNT, default=None,
                        help="CPUs of the local Ray instance (default: all of this machine's)")
@@ -338,7 +326,7 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
                                         "(rliable's method); with two sweeps, P(first beats second). Writes "
                                         "report.md and report_curves.png into the first sweep folder.")
     report.add_argument("sweep_dirs", nargs="+", metavar="SWEEP_DIR")
-    report.add_argument("--reps", type=_whole_number(100, 10**6), default=5000, help="bootstrap resamples")
+    report.add_argument("--reps", type=whole_number(Allowed(low=100, high=10**6)), default=5000, help="bootstrap resamples")
 
     plot = sub.add_parser("plot", help="write the training plots of a run folder (running, interrupted "
                                        "or finished)",

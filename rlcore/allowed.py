@@ -15,6 +15,10 @@ from dataclasses import dataclass
 from rlcore.errors import UserError
 
 
+def _num(x: float) -> str:
+    return str(int(x)) if float(x).is_integer() else f"{x:g}"
+
+
 @dataclass(frozen=True)
 class Allowed:
     """A range (``low``/``high``, each inclusive unless ``*_open``) or a set of ``choices``.
@@ -33,14 +37,14 @@ class Allowed:
             return "one of " + ", ".join(map(str, self.choices))
         if self.low is not None and self.high is not None:
             if not (self.low_open or self.high_open):
-                return f"a number from {self.low:g} to {self.high:g}"
-            left = f"above {self.low:g}" if self.low_open else f"of at least {self.low:g}"
-            right = f"below {self.high:g}" if self.high_open else f"at most {self.high:g}"
+                return f"a number from {_num(self.low)} to {_num(self.high)}"
+            left = f"above {_num(self.low)}" if self.low_open else f"of at least {_num(self.low)}"
+            right = f"below {_num(self.high)}" if self.high_open else f"at most {_num(self.high)}"
             return f"a number {left} and {right}"
         if self.low is not None:
-            return f"a number {'above' if self.low_open else 'of at least'} {self.low:g}"
+            return f"a number {'above' if self.low_open else 'of at least'} {_num(self.low)}"
         if self.high is not None:
-            return f"a number {'below' if self.high_open else 'of at most'} {self.high:g}"
+            return f"a number {'below' if self.high_open else 'of at most'} {_num(self.high)}"
         return "a finite number"
 
     def accepts(self, value) -> bool:
@@ -94,6 +98,21 @@ def check_fields(cfg) -> None:
                 raise invalid(f.name, value, f"a comma-separated list, each item {allowed.describe()}")
         elif not allowed.accepts(value):
             raise invalid(f.name, value, allowed.describe())
+
+
+def whole_number(allowed: Allowed):
+    """An argparse ``type``: a whole number that ``allowed`` accepts (``--episodes``, ``--seed`` ...)."""
+    import argparse
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+        if not allowed.accepts(value):
+            raise argparse.ArgumentTypeError(f"{value} is invalid: allowed is {allowed.describe()}")
+        return value
+    return parse
 
 
 def require(condition: bool, message: str) -> None:

@@ -11,10 +11,13 @@ from __future__ import annotations
 
 class PeriodicEvaluation:
     def __init__(self, cfg, state: dict):
-        self.every = getattr(cfg, "eval_every_steps", 0)  # configs without the field: off
-        self.episodes = getattr(cfg, "eval_episodes", 0)
-        self.keep_best = getattr(cfg, "keep_best", False)
-        self.stop_score = getattr(cfg, "stop_eval_score", 0.0)
+        from rlcore.configs import EpisodeLoop
+
+        on = isinstance(cfg, EpisodeLoop)  # other configs (PPO's) have no periodic evaluation
+        self.every = cfg.eval_every_steps if on else 0
+        self.episodes = cfg.eval_episodes if on else 0
+        self.keep_best = cfg.keep_best if on else False
+        self.stop_score = cfg.stop_eval_score if on else 0.0
         self.max_episode_steps = cfg.max_episode_steps or None
         self.best = state.get("best_eval")  # {"mean", "std", "env_steps"} of the best evaluation
         self.best_weights = None  # its weights, with keep_best
@@ -24,7 +27,7 @@ class PeriodicEvaluation:
         return bool(self.every) and env_steps >= self.next_step
 
     def run(self, experiment, greedy_policy, snapshot, env_steps: int) -> dict:
-        """Evaluate now; return the row for ``evals.csv``. ``snapshot() -> weights``."""
+        """Evaluate now; return its numbers for ``evals.csv``. ``snapshot() -> weights``."""
         from rlcore.evaluation import evaluate
 
         while self.next_step <= env_steps:
@@ -36,7 +39,7 @@ class PeriodicEvaluation:
             self.best = {"mean": round(mean, 2), "std": round(std, 2), "env_steps": env_steps}
             if self.keep_best:
                 self.best_weights = snapshot()
-        return {"env_steps": env_steps, "eval_mean": mean, "eval_std": std}
+        return {"eval_mean": mean, "eval_std": std}
 
     def reached_stop_score(self) -> bool:
         return bool(self.stop_score) and self.best is not None and self.best["mean"] >= self.stop_score

@@ -167,8 +167,9 @@ class TrainingSession:
         ``greedy_policy(obs_batch) -> actions``; ``snapshot() -> weights`` of the model now.
         """
         if self.evaluation.due(self.env_steps):
-            row = self.evaluation.run(self.spec.experiment, greedy_policy, snapshot, self.env_steps)
-            self.tracker.log({"env_steps": self.env_steps, "episode": self.book.episodes, **row}, table="evals")
+            result = self.evaluation.run(self.spec.experiment, greedy_policy, snapshot, self.env_steps)
+            self.tracker.log({"env_steps": self.env_steps, "episode": self.book.episodes, **result},
+                             table="evals")
 
     def should_stop(self) -> bool:
         cfg = self.spec.config
