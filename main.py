@@ -32,7 +32,7 @@ def cmd_list(args) -> int:
         exp = get_experiment(name)
         print(f"{name}: {exp.description}")
         for algo, spec in exp.algos.items():
-            folders = ([shipping.shipped_dir(name, algo)] if "ship_by" not in exp.extra
+            folders = ([shipping.shipped_dir(name, algo)] if not exp.ship_by
                        else sorted((shipping.SAVED_NETWORKS / name).glob("*-*")))
             shipped = [shipping.shipped_summary(f) for f in folders if (f / "meta.json").is_file()]
             print(f"  {algo:<14} {spec.description:<24} presets: {', '.join(spec.presets):<18} "
@@ -49,7 +49,7 @@ def _budget_overrides(args) -> dict:
 def _spec_from_args(args):
     from rlcore.hparams import overrides_from_args
     from rlcore.run import build_spec
-    from rlcore.trainers.session import latest_run_dir, new_run_dir
+    from rlcore.trainers.spec import latest_run_dir, new_run_dir
 
     overrides = {**overrides_from_args(args), **_budget_overrides(args)}
     common = dict(preset=args.preset, seed=args.seed, overrides=overrides, wandb_mode=args.wandb,
@@ -99,7 +99,7 @@ def _model_dir(args) -> Path:
     level = (args.world, args.stage)
     if level == (None, None):
         return Path(args.model) if args.model else shipping.shipped_dir(args.experiment, args.algo)
-    if "ship_by" not in exp.extra:
+    if not exp.ship_by:
         raise UserError(f"--world/--stage choose a Mario level; {exp.name} ships one model per algorithm")
     if args.model:
         raise UserError("give either --model or --world/--stage, not both")
@@ -134,8 +134,8 @@ def _render(model_dir: Path, out: Path, fps: int | None, episodes: int | None, s
     from rlcore.video import record_video
 
     exp, meta, policy = load_policy(model_dir)
-    episodes = exp.extra.get("episodes_per_video", 1) if episodes is None else episodes
-    act = policy.sample if exp.extra.get("success_key") else None  # Mario plays as it was evaluated
+    episodes = exp.episodes_per_video if episodes is None else episodes
+    act = policy.sample if exp.success_key else None  # Mario plays as it was evaluated
     result = record_video(exp, policy, out, fps or exp.video_fps, episodes, seed,
                           make_env=policy.make_env, act=act)
     print(f"video:   {out} ({result['frames']} frames at {result['fps']} fps; "
@@ -156,7 +156,7 @@ def cmd_plot(args) -> int:
     from rlcore.checkpoint import read_checkpoint_state
     from rlcore.experiment import get_experiment
     from rlcore.plotting import plot_run
-    from rlcore.trainers.session import CHECKPOINT_FILE
+    from rlcore.trainers.spec import CHECKPOINT_FILE
 
     run_dir = Path(args.run_dir)
     if not (run_dir / "metrics.csv").is_file():
@@ -393,7 +393,7 @@ def main(argv: list[str] | None = None) -> int:
         print("\naborted (no checkpoint written by this interrupt)", file=sys.stderr)
         return 130
     except Exception as exc:
-        from rlcore.trainers.session import Interrupted
+        from rlcore.trainers.stopping import Interrupted
         if isinstance(exc, Interrupted):
             print(str(exc), file=sys.stderr)
             return 130

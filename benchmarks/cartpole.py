@@ -58,7 +58,7 @@ def bench_train(algo: str, experiment: str, no_eval: bool = False):
     import tempfile
 
     from rlcore.experiment import get_experiment
-    from rlcore.trainers.session import RunSpec
+    from rlcore.trainers.spec import RunSpec
 
     exp = get_experiment(experiment)
     cfg = exp.preset(algo, "default")

@@ -72,7 +72,9 @@ def bench_dqn_costs():
 def bench_train_to_solved(algo: str, seed: int, max_seconds: float):
     import importlib
 
-    from rlcore.trainers.session import Interrupted, RunSpec, TrainingSession
+    from rlcore.trainers.session import TrainingSession
+    from rlcore.trainers.spec import RunSpec
+    from rlcore.trainers.stopping import Interrupted
 
     cfg = dataclasses.replace(EXPERIMENT.preset(algo, "default"), stop_score=EXPERIMENT.solved_score)
     run_dir = Path(tempfile.mkdtemp(prefix=f"bench_{algo}_"))

@@ -94,7 +94,7 @@ def bench_agent():
 
 def bench_train(rollouts: int):
     from rlcore.trainers import ppo
-    from rlcore.trainers.session import RunSpec
+    from rlcore.trainers.spec import RunSpec
 
     steps = rollouts * CFG.n_steps * CFG.num_envs
     cfg = dataclasses.replace(CFG, max_env_steps=steps)

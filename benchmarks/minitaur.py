@@ -85,7 +85,7 @@ def bench_agent():
 
 def bench_train(steps: int):
     from rlcore.trainers import sac
-    from rlcore.trainers.session import RunSpec
+    from rlcore.trainers.spec import RunSpec
 
     cfg = dataclasses.replace(CFG, max_env_steps=steps, eval_every_steps=0, keep_best=False)
     spec = RunSpec(EXPERIMENT, "sac", "default", cfg, 0, "off", Path(tempfile.mkdtemp(prefix="bench_")),

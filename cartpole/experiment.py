@@ -58,7 +58,7 @@ def _experiment(name: str, env_id: str, cap: int) -> Experiment:
                                                                       "default": DQN_DEFAULT}),
             "a2c": AlgoSpec("a2c", "a2c", "A2C, 8 envs, 5-step", a2c_presets()),
         },
-        extra={"score_label": "duration (steps)"},
+        score_label="duration (steps)",
     )
 
 

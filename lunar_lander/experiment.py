@@ -51,7 +51,7 @@ EXPERIMENT = Experiment(
     description="LunarLander-v3 (8-d state, 4 actions; solved = 100-episode mean >= 200), article 000",
     make_env=make_env,
     solved_score=SOLVED_SCORE,
-    extra={"plot_prefix": "LunarLander"},
+    plot_prefix="LunarLander",
     algos={
         "dqn": AlgoSpec("dqn", "dqn", "DQN", _dqn_presets()),
         "ddqn": AlgoSpec("ddqn", "dqn", "Double DQN", _dqn_presets(double=True)),

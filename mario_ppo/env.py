@@ -5,6 +5,7 @@ Stack, innermost first::
     SuperMarioBros-<world>-<stage>-v0        the emulator, one NES frame per step
     JoypadSpace(SIMPLE_MOVEMENT | ...)       discrete button combinations
     ClassicReward                            the reward gym-super-mario-bros had before 9.x
+                                             (+ game score x score_reward, off by default)
     ArticleShaping                           +50 flag / -50 other ends, then / 10
     SkipAndStack(4)                          one action for 4 frames, gray 84x84 frames as channels
 
@@ -14,7 +15,9 @@ env pool's job (Gymnasium vector envs reset an env the step its episode ends).
 gym-super-mario-bros 9 pays a different reward (new-best x only, plus score, coins, power-ups and
 a completion term, unclipped). The article trained on the classic one, rebuilt here from ``info``:
 change of x (ignored when it jumps more than 5, e.g. on a warp), the clock's tick (-1 each time it
-decreases), -25 while dying or dead, the sum clipped to [-15, 15].
+decreases), -25 while dying or dead, the sum clipped to [-15, 15]. The PyTorch original that the
+default preset follows (uvipen's) also adds the change of the game score / 40 (``score_reward``
+0.025): stomping a Goomba (100 points) then pays 2.5, a coin (200) 5.
 
 TensorFlow-free: env-pool worker processes import this module.
 """
@@ -51,18 +54,25 @@ def classic_reward(x_pos: int, x_last: int, time: int, time_last: int, dying: bo
 
 
 class ClassicReward(gym.Wrapper):
-    """Replace the env's reward with :func:`classic_reward`; keep the env's own in ``info``."""
+    """Replace the env's reward with :func:`classic_reward`, plus ``score_reward`` x the change of
+    the game score (unclipped, as uvipen's); keep the env's own reward in ``info``."""
+
+    def __init__(self, env: gym.Env, score_reward: float = 0.0):
+        super().__init__(env)
+        self.score_reward = score_reward
 
     def reset(self, *, seed=None, options=None):
         obs, info = self.env.reset(seed=seed, options=options)
-        self._x_last, self._time_last = info["x_pos"], info["time"]
+        self._x_last, self._time_last, self._score_last = info["x_pos"], info["time"], info["score"]
         return obs, info
 
     def step(self, action):
         obs, env_reward, terminated, truncated, info = self.env.step(action)
         reward = classic_reward(info["x_pos"], self._x_last, info["time"], self._time_last,
                                 info["is_dying"] or info["is_dead"])
-        self._x_last, self._time_last = info["x_pos"], info["time"]
+        if self.score_reward:
+            reward += self.score_reward * (info["score"] - self._score_last)
+        self._x_last, self._time_last, self._score_last = info["x_pos"], info["time"], info["score"]
         info["env_reward"] = env_reward
         return obs, reward, terminated, truncated, info
 
@@ -142,8 +152,9 @@ def _trim(info: dict) -> dict:
 
 
 def make_env(render_mode: str | None = None, max_episode_steps: int | None = None, world: int = 1,
-             stage: int = 1, actions: str = "simple", skip: int = 4) -> gym.Env:
-    """The article's Mario env for one stage. ``max_episode_steps`` counts agent steps (None = none)."""
+             stage: int = 1, actions: str = "simple", skip: int = 4, score_reward: float = 0.0) -> gym.Env:
+    """The article's Mario env for one stage. ``max_episode_steps`` counts agent steps (None = none);
+    ``score_reward``: reward per game-score point (0 = the article's reward)."""
     import gym_super_mario_bros  # noqa: F401  registers the SuperMarioBros-* ids
     from nes_py.wrappers import JoypadSpace
 
@@ -153,7 +164,7 @@ def make_env(render_mode: str | None = None, max_episode_steps: int | None = Non
         raise UserError(f"there is no level {world}-{stage}: world is 1-8, stage 1-4")
     env = gym.make(f"SuperMarioBros-{world}-{stage}-v0", render_mode=render_mode).unwrapped
     env = JoypadSpace(env, action_list(actions))
-    env = SkipAndStack(ArticleShaping(ClassicReward(env)), skip)
+    env = SkipAndStack(ArticleShaping(ClassicReward(env, score_reward)), skip)
     if max_episode_steps:
         env = gym.wrappers.TimeLimit(env, max_episode_steps)
     return env

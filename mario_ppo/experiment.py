@@ -20,6 +20,9 @@ class MarioPPOConfig(PPOConfig):
     stage: int = field(default=1, metadata={"help": "stage", "allowed": Allowed(low=1, high=4)})
     actions: str = field(default="simple", metadata={"help": "button set: 7, 12 or 5 actions",
                                                      "allowed": choices(*ACTION_SETS)})
+    score_reward: float = field(default=0.0, metadata={
+        "help": "reward per game-score point, added before the /10 (uvipen's PyTorch original: "
+                "1/40 = 0.025; 0 = the article's reward)", "allowed": Allowed(low=0, high=1)})
 
 
 # Article 001: 8 envs x 512 steps, GAE gamma 0.99 lambda 0.97, clip 0.2, entropy 0.05, Adam 1e-4,
@@ -54,7 +57,6 @@ EXPERIMENT = Experiment(
     solved_score=None,  # success is the flag, not a return
     algos={"ppo": AlgoSpec("ppo", "ppo", "PPO, 8 envs over Pipes", {"article": ARTICLE, "default": DEFAULT})},
     video_fps=60,
-    extra={"env_fields": ("world", "stage", "actions"), "success_key": "flag_get",
-           "progress_key": "x_pos", "eval_episodes": 10,
-           "ship_by": ("world", "stage"), "default_model": "1-1", "score_label": "return (shaped, /10)"},
+    env_fields=("world", "stage", "actions", "score_reward"), success_key="flag_get", progress_key="x_pos",
+    eval_episodes=10, ship_by=("world", "stage"), default_model="1-1", score_label="return (shaped, /10)",
 )

@@ -25,5 +25,5 @@ EXPERIMENT = Experiment(
     solved_score=15.0,  # the task's registered reward threshold
     algos={"sac": AlgoSpec("sac", "sac", "SAC, twin critics", {"article": ARTICLE, "default": DEFAULT})},
     video_fps=60,
-    extra={"eval_episodes": 30, "episodes_per_video": 3},
+    eval_episodes=30, episodes_per_video=3,
 )

@@ -6,7 +6,7 @@ are imported lazily by module path.
 from __future__ import annotations
 
 import importlib
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from functools import partial
 from typing import Callable
 
@@ -34,23 +34,38 @@ class AlgoSpec:
 
 @dataclass(frozen=True)
 class Experiment:
+    """What an experiment declares. Only the first five are required; the rest say how it is
+    evaluated, shipped, plotted and filmed when it differs from a return-scored gymnasium task."""
     name: str
     description: str
-    make_env: Callable  # make_env(render_mode=None, max_episode_steps=None) -> gymnasium.Env
+    make_env: Callable  # make_env(render_mode=None, max_episode_steps=None, **env_fields) -> gymnasium.Env
     algos: dict[str, AlgoSpec]
     solved_score: float | None  # None: no return threshold (Mario's success is the flag)
     eval_seed_base: int = 1_000_000  # final evaluation seeds start here; training never uses them
     selection_seed_base: int = 2_000_000  # periodic evaluations during training (model selection)
+    eval_episodes: int = 100  # episodes of the final evaluation on unseen seeds
+    # config fields that make_env takes (Mario: world, stage, ...): recorded, so a model rebuilds its env
+    env_fields: tuple[str, ...] = ()
+    # an info key that marks a successful episode (Mario: flag_get). With one, the trainer logs
+    # success per episode, evaluation counts successes and plays sampled actions, not greedy ones
+    success_key: str | None = None
+    progress_key: str | None = None  # an info key that measures progress (Mario: x_pos), logged and plotted
+    # config fields that name a shipped model (Mario: world, stage -> saved_networks/mario_ppo/1-1);
+    # empty: one model per algorithm, saved_networks/EXPERIMENT/ALGO
+    ship_by: tuple[str, ...] = ()
+    default_model: str = ""  # with ship_by: the folder evaluate/render take without --world/--stage
+    score_label: str = "return"  # the y label of the returns plot
+    plot_prefix: str = ""  # the plot files' name prefix (empty: the experiment's name)
     video_fps: int = 30
-    extra: dict = field(default_factory=dict)
+    episodes_per_video: int = 1
 
     def env_factory(self, config=None, **kwargs) -> Callable:
         """A picklable no-argument env constructor for ``config`` (env-pool workers call it).
 
         Experiments whose env depends on hyperparameters (Mario: world, stage, action set) list
-        those fields in ``extra["env_fields"]``.
+        those fields in ``env_fields``.
         """
-        for name in self.extra.get("env_fields", ()):
+        for name in self.env_fields:
             if config is not None:
                 kwargs.setdefault(name, getattr(config, name))
         if config is not None:

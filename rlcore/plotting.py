@@ -17,19 +17,19 @@ def plot_run(run_dir: str | Path, out_dir: str | Path, experiment, about: dict) 
 
     ``about`` says what the run trained (``algo``, ``preset``, ``seed``, ``config``), as a checkpoint's
     state or a ``meta.json`` does. Reads ``metrics.csv`` (one row per episode) and, when present,
-    ``evals.csv``; experiments with a goal (``extra["progress_key"]``) also get the progress plot.
+    ``evals.csv``; experiments with a goal (``progress_key``) also get the progress plot.
     """
     run_dir, out_dir, algo = Path(run_dir), Path(out_dir), about["algo"]
     title = f"{experiment.name} {algo} ({about['preset']} preset, seed {about['seed']})"
     window = about["config"].get("window", 100)
-    prefix = experiment.extra.get("plot_prefix", experiment.name)
-    label = experiment.extra.get("score_label", "return")
+    prefix = experiment.plot_prefix or experiment.name
+    label = experiment.score_label
     metrics, evals = run_dir / "metrics.csv", run_dir / "evals.csv"
     out = [plot_episode_scores(metrics, out_dir / f"{prefix}_Train_{algo}.png", title,
                                experiment.solved_score, label)]
-    if experiment.extra.get("progress_key"):
+    if experiment.progress_key:
         out.append(plot_progress(metrics, out_dir / f"{prefix}_Progress_{algo}.png", title,
-                                 experiment.extra["progress_key"], window))
+                                 experiment.progress_key, window))
     if evals.exists():
         out.append(plot_evaluations(evals, out_dir / f"{prefix}_Eval_{algo}.png", title,
                                     experiment.solved_score, label))

@@ -16,7 +16,7 @@ from typing import Callable
 
 from rlcore.experiment import get_experiment
 from rlcore.hparams import apply_overrides, from_dict
-from rlcore.trainers.session import RunSpec, check_resumable
+from rlcore.trainers.spec import RunSpec, check_resumable
 
 
 def build_spec(experiment: str, algo: str, *, preset: str | None = None, seed: int = 0,

@@ -11,16 +11,16 @@ SAVED_NETWORKS = Path(__file__).resolve().parents[1] / "saved_networks"
 
 def shipped_dir(experiment: str, algo: str, config=None) -> Path:
     """saved_networks/EXPERIMENT/ALGO, or for Mario saved_networks/mario_ppo/WORLD-STAGE (one
-    model per level: ``extra["ship_by"]`` names the config fields; without a config, the
-    experiment's ``extra["default_model"]``)."""
+    model per level: the experiment's ``ship_by`` names the config fields; without a config, its
+    ``default_model``)."""
     from rlcore.experiment import get_experiment
 
-    extra = get_experiment(experiment).extra
-    if "ship_by" not in extra:
+    exp = get_experiment(experiment)
+    if not exp.ship_by:
         return SAVED_NETWORKS / experiment / algo
     if config is None:
-        return SAVED_NETWORKS / experiment / extra["default_model"]
-    return SAVED_NETWORKS / experiment / "-".join(str(getattr(config, f)) for f in extra["ship_by"])
+        return SAVED_NETWORKS / experiment / exp.default_model
+    return SAVED_NETWORKS / experiment / "-".join(str(getattr(config, f)) for f in exp.ship_by)
 
 
 
@@ -36,7 +36,7 @@ def shipped_summary(folder: Path) -> str:
 
 
 def eval_episodes(exp, requested: int | None) -> int:
-    return exp.extra.get("eval_episodes", 100) if requested is None else requested
+    return exp.eval_episodes if requested is None else requested
 
 
 def run_evaluation(exp, policy, episodes: int, seed_base: int | None) -> tuple[dict, str]:
@@ -47,7 +47,7 @@ def run_evaluation(exp, policy, episodes: int, seed_base: int | None) -> tuple[d
     """
     seed_base = exp.eval_seed_base if seed_base is None else seed_base
     seeds = f"{seed_base}..{seed_base + episodes - 1}"
-    success_key, progress_key = exp.extra.get("success_key"), exp.extra.get("progress_key")
+    success_key, progress_key = exp.success_key, exp.progress_key
     if success_key:
         from rlcore.evaluation import evaluate_success, summarize_success
 

@@ -147,7 +147,7 @@ def run_trial(trial: dict, sweep: dict, modules: dict, report) -> dict:
 
     from rlcore import shipping
     from rlcore.run import build_spec, run_training
-    from rlcore.trainers.session import Interrupted
+    from rlcore.trainers.stopping import Interrupted
 
     resume = (run_dir / "checkpoint.npz").is_file()
     values = {k: v for k, v in trial.items() if k != "seed"}

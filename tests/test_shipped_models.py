@@ -34,7 +34,7 @@ def test_no_model_is_shipped_without_a_bar():
         for algo in get_experiment(name).algos:
             if (SHIPPED / name / algo / "meta.json").exists():
                 assert (name, algo) in BARS
-            if "ship_by" in get_experiment(name).extra:
+            if get_experiment(name).ship_by:
                 for meta in (SHIPPED / name).glob("*/meta.json"):
                     assert (name, algo, meta.parent.name) in SUCCESS_BARS, meta
 
@@ -47,7 +47,7 @@ def test_shipped_model_meets_its_bar(experiment, algo):
     assert meta["command"].startswith(f"python main.py train {experiment} {algo}")
     for key in ("seed", "env_steps", "episodes", "wall_seconds", "config", "versions"):
         assert key in meta, key
-    assert meta["evaluation"]["episodes"] == exp.extra.get("eval_episodes", 100)
+    assert meta["evaluation"]["episodes"] == exp.eval_episodes
     assert meta["evaluation"]["mean"] >= bar
     # and it still plays: seeded episodes from the unseen-seed range
     returns = evaluate(exp, policy, episodes=EPISODES.get(experiment, 5), progress=False)
@@ -63,7 +63,7 @@ def test_shipped_model_reaches_its_goal(experiment, algo, folder):
     assert meta["command"].startswith(f"python main.py train {experiment} {algo}")
     assert meta["evaluation"]["success_share"] > 0
     records = evaluate_success(policy.make_env, policy.sample, 3, exp.eval_seed_base, key,
-                               exp.extra.get("progress_key"), progress=False, stop_at_success=True)
+                               exp.progress_key, progress=False, stop_at_success=True)
     assert any(r["success"] for r in records), records
 
 

@@ -59,7 +59,7 @@ EXPERIMENT = Experiment(
 
 
 def spec(algo, tmp_path, **overrides):
-    from rlcore.trainers.session import RunSpec
+    from rlcore.trainers.spec import RunSpec
 
     experiment = {"ppo": IMAGE_EXPERIMENT, "sac": REACH_EXPERIMENT}.get(algo, EXPERIMENT)
     cfg = dataclasses.replace(experiment.preset(algo, None), **overrides)
@@ -114,7 +114,7 @@ PPO = PPOConfig(num_envs=2, vec="inline", n_steps=16, epochs=4, minibatch=16, lr
 IMAGE_EXPERIMENT = Experiment(
     name="toy_image", description="sign bandit as pictures", make_env=make_image_env, solved_score=None,
     algos={"ppo": AlgoSpec("ppo", "ppo", "PPO", {"default": PPO})},
-    eval_seed_base=10_000, extra={"success_key": "won", "progress_key": "score", "eval_episodes": 10})
+    eval_seed_base=10_000, success_key="won", progress_key="score", eval_episodes=10)
 
 
 class ReachEnv(gym.Env):

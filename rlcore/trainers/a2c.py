@@ -11,7 +11,8 @@ import tensorflow as tf
 from rlcore.agents.a2c import A2CAgent
 from rlcore.checkpoint import load_checkpoint, save_checkpoint
 from rlcore.errors import UserError
-from rlcore.trainers.session import RunSpec, TrainingSession, check_resumable
+from rlcore.trainers.session import TrainingSession
+from rlcore.trainers.spec import RunSpec, check_resumable
 from rlcore.vector import EnvPool, bootstrap_observations
 from rlcore.seeding import training_env_seed
 

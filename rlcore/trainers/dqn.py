@@ -12,7 +12,8 @@ from rlcore.agents.dqn import DQNAgent
 from rlcore.errors import UserError
 from rlcore.replay import ReplayMemory
 from rlcore.trainers import replay_io
-from rlcore.trainers.session import RunSpec, TrainingSession
+from rlcore.trainers.session import TrainingSession
+from rlcore.trainers.spec import RunSpec
 from rlcore.seeding import training_env_seed
 
 

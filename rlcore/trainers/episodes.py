@@ -1,4 +1,5 @@
-"""Episode book-keeping as article 000 does it: returns, the moving average, its console lines."""
+"""Episode book-keeping as article 000 does it: returns, the moving average, its console lines; and,
+for experiments with a goal (Mario's flag), which episodes reached it."""
 from __future__ import annotations
 
 import numpy as np
@@ -6,11 +7,13 @@ from tqdm import tqdm
 
 
 class EpisodeBook:
-    """Episode returns, the moving average, and the article's console line and wandb keys."""
+    """Episode returns, the moving average, successes, and the article's console line and wandb keys."""
 
-    def __init__(self, window: int, solved_score: float | None, returns: list[float] | None = None):
+    def __init__(self, window: int, solved_score: float | None, returns: list[float] | None = None,
+                 successes: list[bool] | None = None):
         self.window, self.solved_score = window, solved_score
         self.returns: list[float] = list(returns or [])
+        self.successes: list[bool] = list(successes or [])  # only episodes that report success
         self.solved_episode: int | None = None
 
     @property
@@ -21,11 +24,17 @@ class EpisodeBook:
     def average(self) -> float:
         return float(np.mean(self.returns[-self.window:])) if self.returns else float("nan")
 
+    @property
+    def success_share(self) -> float:
+        """Share of the last ``window`` episodes that succeeded (0 before any)."""
+        recent = self.successes[-self.window:]
+        return float(np.mean(recent)) if recent else 0.0
+
     def full_window(self) -> bool:
         return len(self.returns) >= self.window
 
-    def add(self, episode_return: float) -> dict:
-        """Record one episode; return the article's per-episode metrics."""
+    def add(self, episode_return: float, success: bool | None = None) -> dict:
+        """Record one episode; return the article's per-episode metrics (and success, when given)."""
         self.returns.append(float(episode_return))
         if (self.solved_score is not None and self.solved_episode is None and self.full_window()
                 and self.average >= self.solved_score):
@@ -34,5 +43,9 @@ class EpisodeBook:
         if self.episodes % self.window == 0:
             tqdm.write(f"Episode {self.episodes} | Total point average of the last {self.window} "
                        f"episodes: {self.average:.2f}")
-        return {"episode": self.episodes, "total_points": float(episode_return),
-                "av_latest_points": self.average, "target_ave_scores": self.solved_score}
+        row = {"episode": self.episodes, "total_points": float(episode_return),
+               "av_latest_points": self.average, "target_ave_scores": self.solved_score}
+        if success is not None:
+            self.successes.append(bool(success))
+            row.update(success=int(success), success_share=self.success_share)
+        return row

@@ -7,7 +7,6 @@ article's console line).
 """
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import keras
@@ -16,10 +15,10 @@ import tensorflow as tf
 from tqdm import tqdm
 
 from rlcore.agents.ppo import LOSS_NAMES, MODEL_FILE, PPOAgent
-from rlcore.atomic import write_json
 from rlcore.checkpoint import load_checkpoint, save_checkpoint
 from rlcore.errors import UserError
-from rlcore.trainers.session import RunSpec, TrainingSession, check_resumable
+from rlcore.trainers.session import TrainingSession
+from rlcore.trainers.spec import RunSpec, check_resumable
 from rlcore.vector import EnvPool
 from rlcore.seeding import training_env_seed
 
@@ -63,7 +62,7 @@ def train(spec: RunSpec) -> Path:
     obs_shape, n_actions = envs.single_observation_space.shape, int(envs.single_action_space.n)
     agent = PPOAgent(obs_shape, n_actions, cfg)
     rng = np.random.default_rng(spec.seed)
-    success_key, progress_key = exp.extra.get("success_key"), exp.extra.get("progress_key")
+    success_key, progress_key = exp.success_key, exp.progress_key
 
     state = check_resumable(spec) if spec.resume else None
     if state is not None:
@@ -73,22 +72,21 @@ def train(spec: RunSpec) -> Path:
     else:
         parent = init_weights(agent, cfg.init_from, exp.name, spec.algo) if cfg.init_from else None
     session = TrainingSession(spec, state, progress_unit="step")
-    successes = list(state.get("successes", [])) if state else []
+    book = session.book
     rollouts = int(state.get("rollouts", 0)) if state else 0
 
     def checkpoint():
         save_checkpoint(session.checkpoint_path, agent.models(), agent.optimizers(),
-                        session.state(rng=rng.bit_generator.state, rollouts=rollouts, successes=successes,
-                                      init_from=parent))
+                        session.state(rng=rng.bit_generator.state, rollouts=rollouts, init_from=parent))
 
     t, n = cfg.n_steps, cfg.num_envs
     buf = Rollout(t, n, obs_shape)
     running = np.zeros(n)
     losses = {name: float("nan") for name in LOSS_NAMES}  # CSV columns exist from the first row
     # a resumed run starts fresh episodes, reseeded from its episode count
-    obs, _ = envs.reset(seed=[training_env_seed(spec.seed, session.book.episodes + i) for i in range(n)])
+    obs, _ = envs.reset(seed=[training_env_seed(spec.seed, book.episodes + i) for i in range(n)])
     with envs, session.interruptible():
-        while not session.should_stop() and not _succeeded(successes, cfg):
+        while not session.should_stop():
             max_x, min_x, ended, flags = -np.inf, np.inf, 0, 0
             truncated_values = {}
             for step in range(t):
@@ -106,18 +104,15 @@ def train(spec: RunSpec) -> Path:
                     finals = agent.values(np.stack([infos["final_obs"][i] for i in cut]))
                     truncated_values.update({(step, i): float(v) for i, v in zip(cut, finals)})
                 for i in np.flatnonzero(done):
-                    extra = dict(losses)
+                    extra, won = dict(losses), None
                     if progress_key:
                         x = float(_final(infos, progress_key, i))
                         max_x, min_x = max(max_x, x), min(min_x, x)
                         extra[progress_key] = x
                     if success_key:
                         won = bool(_final(infos, success_key, i, False))
-                        successes.append(won)
                         flags += won
-                        extra["success"] = int(won)
-                        extra["success_share"] = _share(successes, cfg.window)
-                    session.end_episode(running[i], extra)
+                    session.end_episode(running[i], extra, success=won)
                     running[i] = 0.0
                     ended += 1
                 obs = next_obs
@@ -131,26 +126,22 @@ def train(spec: RunSpec) -> Path:
                 raise UserError(f"training diverged: NaN/Inf in the PPO loss at env step {session.env_steps}; "
                                 "lower the learning rate or resume from the last checkpoint") from None
             rollouts += 1
-            session.tracker.log({"rollout": rollouts, "env_steps": session.env_steps,
-                                 "episodes_ended": ended, "successes": flags,
-                                 f"max_{progress_key or 'x'}": max_x, **losses}, table="rollouts")
-            line = f"rollout {rollouts} | env steps {session.env_steps:,} | episodes {session.book.episodes:,}"
+            session.log_rollout(rollouts, {"episodes_ended": ended, "successes": flags,
+                                           f"max_{progress_key or 'x'}": max_x, **losses})
+            line = f"rollout {rollouts} | env steps {session.env_steps:,} | episodes {book.episodes:,}"
             if progress_key:
                 line += (f" | max {progress_key} {max_x:.0f} | min {progress_key} "
                          f"{min_x if np.isfinite(min_x) else float('nan'):.0f}")
             if success_key:
-                line += f" | {success_key} {flags}/{ended} (last {cfg.window}: {_share(successes, cfg.window):.0%})"
+                line += f" | {success_key} {flags}/{ended} (last {cfg.window}: {book.success_share:.0%})"
             tqdm.write(line + f" | loss {losses['loss']:.3f} entropy {losses['entropy']:.2f}")
             if rollouts % cfg.checkpoint_rollouts == 0:
                 checkpoint()
     checkpoint()
     if session.stop_requested:
         raise session.interrupted()
-    model_dir = session.finish(agent.save)
-    if parent:  # the model's story starts with the run whose weights it started from
-        meta = json.loads((model_dir / "meta.json").read_text())
-        write_json(model_dir / "meta.json", {**meta, "init_from": parent})
-    return model_dir
+    # the model's story starts with the run whose weights it started from
+    return session.finish(agent.save, **({"init_from": parent} if parent else {}))
 
 
 def init_weights(agent: PPOAgent, folder: str, experiment: str, algo: str) -> dict:
@@ -167,13 +158,3 @@ def init_weights(agent: PPOAgent, folder: str, experiment: str, algo: str) -> di
     agent.set_weights(source.get_weights())
     keep = ("config", "commands", "env_steps", "episodes", "wall_seconds", "evaluation", "init_from")
     return {"path": str(folder), **{k: meta[k] for k in keep if k in meta}}
-
-
-def _share(successes: list, window: int) -> float:
-    recent = successes[-window:]
-    return float(np.mean(recent)) if recent else 0.0
-
-
-def _succeeded(successes: list, cfg) -> bool:
-    return (cfg.stop_success_share > 0 and len(successes) >= cfg.window
-            and _share(successes, cfg.window) >= cfg.stop_success_share)

@@ -6,7 +6,8 @@ import numpy as np
 
 from rlcore.checkpoint import load_checkpoint, save_checkpoint
 from rlcore.replay import ReplayMemory
-from rlcore.trainers.session import RunSpec, TrainingSession, check_resumable
+from rlcore.trainers.session import TrainingSession
+from rlcore.trainers.spec import RunSpec, check_resumable
 
 
 def resume(spec: RunSpec, agent, memory: ReplayMemory, rng: np.random.Generator) -> tuple[dict | None, dict]:

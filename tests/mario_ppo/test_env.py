@@ -1,8 +1,9 @@
 """The Mario wrappers on the real NES emulator: frames, stacking, the classic reward and the shaping."""
+import gymnasium as gym
 import numpy as np
 import pytest
 
-from mario_ppo.env import FRAME_SIZE, classic_reward, gray_84, make_env
+from mario_ppo.env import FRAME_SIZE, ClassicReward, classic_reward, gray_84, make_env
 from rlcore.errors import UserError
 
 RIGHT = 1  # SIMPLE_MOVEMENT[1] == ['right']
@@ -78,6 +79,35 @@ def test_classic_reward_rules():
     assert classic_reward(100, 100, 399, 400, False) == -1  # the clock ticked
     assert classic_reward(100, 100, 400, 300, False) == 0  # the clock went up: a reset
     assert classic_reward(104, 100, 399, 400, True) == -15  # 4 - 1 - 25 = -22, clipped to -15
+
+
+class _ScriptedInfos(gym.Env):
+    """A stand-in emulator that replays a list of infos (x, clock, score, dying)."""
+    observation_space, action_space = gym.spaces.Discrete(1), gym.spaces.Discrete(1)
+
+    def __init__(self, infos):
+        self.infos = [dict(x_pos=x, time=t, score=sc, is_dying=d, is_dead=False) for x, t, sc, d in infos]
+
+    def reset(self, *, seed=None, options=None):
+        self.i = 0
+        return 0, self.infos[0]
+
+    def step(self, action):
+        self.i += 1
+        return 0, 123.0, False, False, self.infos[self.i]
+
+
+def _classic_rewards(infos, score_reward):
+    env = ClassicReward(_ScriptedInfos(infos), score_reward)
+    env.reset()
+    return [env.step(0)[1] for _ in infos[1:]]
+
+
+def test_score_reward_adds_the_change_of_the_game_score():
+    infos = [(100, 400, 0, False), (103, 400, 100, False), (104, 399, 100, False), (104, 399, 300, True)]
+    assert _classic_rewards(infos, 0.0) == [3, 0, -15]  # the article's reward ignores the score
+    # uvipen's 1/40: +2.5 for a 100-point stomp, +5 for 200 points, added after the clip
+    assert _classic_rewards(infos, 0.025) == [3 + 2.5, 0, -15 + 5]
 
 
 def test_unknown_level_and_action_set_are_clear_errors():

@@ -8,7 +8,7 @@ import numpy as np
 from rlcore.agents.ppo import PPOAgent
 from rlcore.experiment import AlgoSpec, Experiment
 from rlcore.trainers import ppo as ppo_trainer
-from rlcore.trainers.session import RunSpec
+from rlcore.trainers.spec import RunSpec
 from tests.toy import PPO
 
 LIMIT = 5

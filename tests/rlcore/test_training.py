@@ -14,7 +14,8 @@ from rlcore.trainers import a2c as a2c_trainer
 from rlcore.trainers import dqn as dqn_trainer
 from rlcore.trainers import ppo as ppo_trainer
 from rlcore.trainers import sac as sac_trainer
-from rlcore.trainers.session import Interrupted, check_resumable
+from rlcore.trainers.spec import check_resumable
+from rlcore.trainers.stopping import Interrupted
 from tests import toy
 
 TRAINERS = {"dqn": dqn_trainer, "a2c": a2c_trainer, "ppo": ppo_trainer, "sac": sac_trainer}
@@ -46,6 +47,7 @@ def test_ppo_learns_the_picture_task_and_stops_on_the_success_share(tmp_path):
     model_dir = ppo_trainer.train(toy.spec("ppo", tmp_path))
     meta = json.loads((model_dir / "meta.json").read_text())
     assert meta["episodes"] < 600, "stopped by the budget, not by the success share"
+    assert meta["stopped_by"].startswith("stop_success_share")
     rollouts = (tmp_path / "ppo" / "rollouts.csv").read_text().splitlines()
     assert rollouts[0].startswith("rollout,env_steps,episodes_ended,successes,max_score,loss,policy_loss")
     metrics = (model_dir / "metrics.csv").read_text().splitlines()
@@ -89,10 +91,10 @@ def _interrupt_after(episodes, trainer, spec):
     from rlcore.trainers import session as session_mod
     original = session_mod.TrainingSession.end_episode
 
-    def end_episode(self, episode_return, extra):
-        original(self, episode_return, extra)
+    def end_episode(self, episode_return, extra, success=None):
+        original(self, episode_return, extra, success)
         if self.book.episodes == episodes:
-            self.stop_requested = True
+            self.stop.requested = True
     session_mod.TrainingSession.end_episode = end_episode
     try:
         with pytest.raises(Interrupted):

@@ -1,0 +1,40 @@
+"""A finished run's ``model/`` folder: the ``.h5`` files, the plot, every CSV table and ``meta.json``
+(what the run was, the commands that made it, its counters, and the package versions)."""
+from __future__ import annotations
+
+import platform
+from datetime import datetime, timezone
+from pathlib import Path
+
+from rlcore.atomic import write_json
+from rlcore.plotting import plot_run
+
+
+def package_versions() -> dict:
+    """Versions of Python and of the packages a run's numbers depend on (those installed)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    found = {"python": platform.python_version()}
+    for dist in ("tensorflow", "tensorflow-cpu", "keras", "gymnasium", "numpy", "box2d", "nes-py",
+                 "gym-super-mario-bros", "pybullet"):
+        try:
+            found[dist] = version(dist)
+        except PackageNotFoundError:
+            pass
+    return found
+
+
+def write_model_folder(run_dir: Path, experiment, describe: dict, save_models, record: dict) -> Path:
+    """``save_models(folder)`` writes the model files; ``record`` (commands, counters, ...) goes into
+    meta.json after ``describe`` (what the run is). Returns the folder."""
+    model_dir = run_dir / "model"
+    model_dir.mkdir(parents=True, exist_ok=True)
+    files = [p.name for p in save_models(model_dir)]
+    plot_name = plot_run(run_dir, model_dir, experiment, describe)[0].name
+    for table in sorted(run_dir.glob("*.csv")):  # metrics, evals, rollouts: all ship
+        (model_dir / table.name).write_bytes(table.read_bytes())
+    meta = {**describe, "command": record["commands"][0], **record, "model_files": files,
+            "plot": plot_name, "versions": package_versions(),
+            "finished": datetime.now(timezone.utc).isoformat(timespec="seconds")}
+    write_json(model_dir / "meta.json", meta)
+    return model_dir

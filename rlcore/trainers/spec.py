@@ -1,0 +1,68 @@
+"""What defines a training run, and where its folder is: :class:`RunSpec`, new and latest run folders,
+and the check that a checkpoint belongs to the run that wants to resume it."""
+from __future__ import annotations
+
+import shlex
+import sys
+from dataclasses import dataclass, field
+from datetime import datetime
+from pathlib import Path
+from typing import Callable
+
+from rlcore.checkpoint import read_checkpoint_state
+from rlcore.errors import UserError
+
+RUNS_DIR = Path("runs")
+CHECKPOINT_FILE = "checkpoint.npz"
+
+
+@dataclass
+class RunSpec:
+    """Everything that defines a training run (what ``main.py train`` parsed)."""
+    experiment: object  # rlcore.experiment.Experiment
+    algo: str
+    preset: str
+    config: object
+    seed: int
+    wandb_mode: str = "auto"
+    run_dir: Path | None = None
+    resume: bool = False
+    command: str = field(default_factory=lambda: " ".join(shlex.quote(a) for a in ["python", *sys.argv]))
+    progress: bool = True
+    # on_progress(row, table): every row the run logs (episodes, evaluations, rollouts), as it comes
+    on_progress: Callable[[dict, str], None] | None = None
+    # a file whose appearance stops the run at its next safe point, with a checkpoint (sweeps' Ctrl-C)
+    stop_file: Path | None = None
+
+    @property
+    def kind(self) -> str:
+        return self.experiment.algo(self.algo).kind
+
+    def describe(self) -> dict:
+        """What the run is, as CSV headers, checkpoints and meta.json record it."""
+        from rlcore.hparams import to_dict
+
+        return {"experiment": self.experiment.name, "algo": self.algo, "kind": self.kind,
+                "preset": self.preset, "seed": self.seed, "config": to_dict(self.config)}
+
+
+def new_run_dir(experiment: str, algo: str, seed: int) -> Path:
+    stamp = datetime.now().strftime("%Y%m%d-%H%M%S")
+    return RUNS_DIR / f"{experiment}__{algo}__{seed}__{stamp}"
+
+
+def latest_run_dir(experiment: str, algo: str) -> Path:
+    runs = sorted(RUNS_DIR.glob(f"{experiment}__{algo}__*/{CHECKPOINT_FILE}"), key=lambda p: p.stat().st_mtime)
+    if not runs:
+        raise UserError(f"no run of {experiment} {algo} with a checkpoint under {RUNS_DIR}/ to resume")
+    return runs[-1].parent
+
+
+def check_resumable(spec: RunSpec) -> dict:
+    """The checkpoint's state, after checking it belongs to this experiment and algorithm."""
+    state = read_checkpoint_state(spec.run_dir / CHECKPOINT_FILE)
+    found = (state.get("experiment"), state.get("algo"))
+    if found != (spec.experiment.name, spec.algo):
+        raise UserError(f"checkpoint in {spec.run_dir} is from {found[0]} {found[1]}, "
+                        f"not {spec.experiment.name} {spec.algo}; pick the matching run")
+    return state

@@ -1,0 +1,88 @@
+"""When a run stops. Two kinds of reason, kept apart:
+
+- :class:`StopRequest`: someone asked (Ctrl-C, or a sweep's stop file). The loop stops at its next
+  safe point, writes a checkpoint and raises :class:`Interrupted`; the run can be resumed.
+- :class:`StopRules`: the run is done (a budget is spent or a goal reached). It then writes its
+  model folder; ``meta.json`` records which rule ended it.
+"""
+from __future__ import annotations
+
+import contextlib
+import signal
+import threading
+import time
+from pathlib import Path
+
+from tqdm import tqdm
+
+
+class Interrupted(Exception):
+    """Raised after Ctrl-C once the checkpoint is safely written."""
+
+    def __init__(self, checkpoint: Path):
+        super().__init__(f"interrupted; checkpoint saved to {checkpoint}; continue with --resume {checkpoint.parent}")
+        self.checkpoint = checkpoint
+
+
+class StopRequest:
+    """Ctrl-C or a stop file: ``requested`` turns true, and stays true. The file is looked at no
+    more than once per ``FILE_CHECK_SECONDS`` (loops poll every env step)."""
+    FILE_CHECK_SECONDS = 0.5
+
+    def __init__(self, stop_file: Path | None = None):
+        self.stop_file = stop_file
+        self.requested = False
+        self._next_look = 0.0
+
+    def poll(self) -> bool:
+        if not self.requested and self.stop_file is not None and time.monotonic() >= self._next_look:
+            self._next_look = time.monotonic() + self.FILE_CHECK_SECONDS
+            self.requested = self.stop_file.exists()
+        return self.requested
+
+    @contextlib.contextmanager
+    def catching_ctrl_c(self):
+        """First Ctrl-C sets ``requested`` (the loop checkpoints and stops); the second aborts."""
+        def handler(signum, frame):
+            if self.requested:
+                raise KeyboardInterrupt
+            self.requested = True
+            tqdm.write("\nCtrl-C: stopping at the next safe point and saving a checkpoint "
+                       "(press again to abort without saving)")
+        if threading.current_thread() is not threading.main_thread():
+            yield  # a Ray trial runs in a worker thread: its sweep stops it through the stop file
+            return
+        previous = signal.signal(signal.SIGINT, handler)
+        try:
+            yield
+        finally:
+            signal.signal(signal.SIGINT, previous)
+
+
+class StopRules:
+    """The budgets and goals of a config (``RunBudget`` and its subclasses), checked in this order:
+
+    episodes: ``max_episodes`` finished; steps: ``max_env_steps`` spent (0 = no limit);
+    eval score: a periodic evaluation reached ``stop_eval_score``; success share: at least
+    ``stop_success_share`` of the last ``window`` episodes succeeded (e.g. reached the flag);
+    average: the mean return of the last ``window`` episodes reached ``stop_score``.
+    """
+
+    def __init__(self, cfg):
+        self.cfg = cfg
+        self.success_share = getattr(cfg, "stop_success_share", 0.0)  # only PPOConfig declares it
+
+    def reason(self, book, env_steps: int, evaluation) -> str | None:
+        cfg = self.cfg
+        if book.episodes >= cfg.max_episodes:
+            return f"max_episodes {cfg.max_episodes}"
+        if cfg.max_env_steps and env_steps >= cfg.max_env_steps:
+            return f"max_env_steps {cfg.max_env_steps}"
+        if evaluation.reached_stop_score():
+            return f"stop_eval_score {evaluation.stop_score}"
+        if self.success_share and len(book.successes) >= cfg.window \
+                and book.success_share >= self.success_share:
+            return f"stop_success_share {self.success_share}"
+        if book.full_window() and book.average >= cfg.stop_score:
+            return f"stop_score {cfg.stop_score}"
+        return None
