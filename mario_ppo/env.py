@@ -8,6 +8,8 @@ Stack, innermost first::
                                              (+ game score x score_reward, off by default)
     ArticleShaping                           +50 flag / -50 other ends, then / 10
     SkipAndStack(4)                          one action for 4 frames, gray 84x84 frames as channels
+    StallLimit(n)                            truncate once x has not passed its best for n agent
+                                             steps (off by default)
 
 Observations are ``uint8 [84, 84, 4]``; the model scales them to [0, 1] itself. Auto-reset is the
 env pool's job (Gymnasium vector envs reset an env the step its episode ends).
@@ -147,14 +149,44 @@ class SkipAndStack(gym.Wrapper):
         return obs, total, terminated, truncated, _trim(info)
 
 
+class StallLimit(gym.Wrapper):
+    """Truncate the episode once Mario's x has not passed its best for ``steps`` agent steps.
+
+    Seen on 1-2: a policy that jumps onto a ledge below a wall pushes right against the wall until
+    the clock runs out (about 1,500 agent steps), so a rollout of 8 x 512 steps held 2-4 episodes,
+    nearly all of them at that wall. A truncation is not an outcome: PPO bootstraps it from V, as
+    any time limit, and the env starts a new episode.
+    """
+
+    def __init__(self, env: gym.Env, steps: int):
+        super().__init__(env)
+        self.steps = steps
+
+    def reset(self, *, seed=None, options=None):
+        obs, info = self.env.reset(seed=seed, options=options)
+        self._best, self._since = info["x_pos"], 0
+        return obs, info
+
+    def step(self, action):
+        obs, reward, terminated, truncated, info = self.env.step(action)
+        if info["x_pos"] > self._best:
+            self._best, self._since = info["x_pos"], 0
+        else:
+            self._since += 1
+        info["stalled"] = self._since >= self.steps
+        return obs, reward, terminated, truncated or info["stalled"], info
+
+
 def _trim(info: dict) -> dict:
     return {k: info[k] for k in INFO_KEYS if k in info}
 
 
 def make_env(render_mode: str | None = None, max_episode_steps: int | None = None, world: int = 1,
-             stage: int = 1, actions: str = "simple", skip: int = 4, score_reward: float = 0.0) -> gym.Env:
+             stage: int = 1, actions: str = "simple", skip: int = 4, score_reward: float = 0.0,
+             stall_steps: int = 0) -> gym.Env:
     """The article's Mario env for one stage. ``max_episode_steps`` counts agent steps (None = none);
-    ``score_reward``: reward per game-score point (0 = the article's reward)."""
+    ``score_reward``: reward per game-score point (0 = the article's reward); ``stall_steps``: end
+    an episode (as a truncation) after this many agent steps without a new best x (0 = never)."""
     import gym_super_mario_bros  # noqa: F401  registers the SuperMarioBros-* ids
     from nes_py.wrappers import JoypadSpace
 
@@ -165,6 +197,8 @@ def make_env(render_mode: str | None = None, max_episode_steps: int | None = Non
     env = gym.make(f"SuperMarioBros-{world}-{stage}-v0", render_mode=render_mode).unwrapped
     env = JoypadSpace(env, action_list(actions))
     env = SkipAndStack(ArticleShaping(ClassicReward(env, score_reward)), skip)
+    if stall_steps:
+        env = StallLimit(env, stall_steps)
     if max_episode_steps:
         env = gym.wrappers.TimeLimit(env, max_episode_steps)
     return env

@@ -9,7 +9,7 @@ import dataclasses
 from dataclasses import dataclass, field
 
 from mario_ppo.env import ACTION_SETS, make_env
-from rlcore.allowed import Allowed, choices
+from rlcore.allowed import OFF_OR_COUNT, Allowed, choices
 from rlcore.configs import PPOConfig
 from rlcore.experiment import AlgoSpec, Experiment
 
@@ -23,6 +23,9 @@ class MarioPPOConfig(PPOConfig):
     score_reward: float = field(default=0.0, metadata={
         "help": "reward per game-score point, added before the /10 (uvipen's PyTorch original: "
                 "1/40 = 0.025; 0 = the article's reward)", "allowed": Allowed(low=0, high=1)})
+    stall_steps: int = field(default=0, metadata={
+        "help": "end an episode (truncated, bootstrapped) after this many agent steps without a new "
+                "best x (0 = never)", "allowed": OFF_OR_COUNT})
 
 
 # Article 001: 8 envs x 512 steps, GAE gamma 0.99 lambda 0.97, clip 0.2, entropy 0.05, Adam 1e-4,
@@ -57,6 +60,6 @@ EXPERIMENT = Experiment(
     solved_score=None,  # success is the flag, not a return
     algos={"ppo": AlgoSpec("ppo", "ppo", "PPO, 8 envs over Pipes", {"article": ARTICLE, "default": DEFAULT})},
     video_fps=60,
-    env_fields=("world", "stage", "actions", "score_reward"), success_key="flag_get", progress_key="x_pos",
+    env_fields=("world", "stage", "actions", "score_reward", "stall_steps"), success_key="flag_get", progress_key="x_pos",
     eval_episodes=10, ship_by=("world", "stage"), default_model="1-1", score_label="return (shaped, /10)",
 )

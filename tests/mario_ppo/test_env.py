@@ -3,7 +3,7 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-from mario_ppo.env import FRAME_SIZE, ClassicReward, classic_reward, gray_84, make_env
+from mario_ppo.env import FRAME_SIZE, ClassicReward, StallLimit, classic_reward, gray_84, make_env
 from rlcore.errors import UserError
 
 RIGHT = 1  # SIMPLE_MOVEMENT[1] == ['right']
@@ -108,6 +108,16 @@ def test_score_reward_adds_the_change_of_the_game_score():
     assert _classic_rewards(infos, 0.0) == [3, 0, -15]  # the article's reward ignores the score
     # uvipen's 1/40: +2.5 for a 100-point stomp, +5 for 200 points, added after the clip
     assert _classic_rewards(infos, 0.025) == [3 + 2.5, 0, -15 + 5]
+
+
+def test_stall_limit_truncates_after_steps_without_a_new_best_x():
+    xs = [100, 101, 102, 102, 90, 102, 103, 103, 103, 103]
+    env = StallLimit(_ScriptedInfos([(x, 400, 0, False) for x in xs]), steps=3)
+    env.reset()
+    steps = [env.step(0) for _ in xs[1:]]
+    # best x 102 at step 2; steps 3, 4, 5 bring nothing new -> truncated at step 5; 103 resets the count
+    assert [s[3] for s in steps] == [False, False, False, False, True, False, False, False, True]
+    assert not any(s[2] for s in steps)  # a truncation, never a termination (PPO bootstraps it)
 
 
 def test_unknown_level_and_action_set_are_clear_errors():
