@@ -6,20 +6,11 @@ import warnings
 from pathlib import Path
 
 import keras
-import numpy as np
 
 import rlcore.layers  # noqa: F401  registers our custom layers before deserializing
 import rlcore.quiet  # noqa: F401  drops Keras's "legacy HDF5" log line: .h5 is what we write on purpose
 from rlcore.atomic import atomic_path
 from rlcore.errors import UserError
-
-
-def numpy_relu_trunk(weights: list[np.ndarray], obs: np.ndarray) -> np.ndarray:
-    """ReLU Dense layers in numpy, from (kernel, bias) pairs in ``model.get_weights()`` order."""
-    x = obs
-    for kernel, bias in zip(weights[::2], weights[1::2]):
-        x = np.maximum(x @ kernel + bias, 0.0)
-    return x
 
 
 def save_keras_model(model: keras.Model, path: str | os.PathLike) -> Path:

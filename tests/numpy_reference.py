@@ -90,6 +90,24 @@ def mlp(weights, x, final_relu=False):
     return x
 
 
+def q_values(weights, obs, dueling):
+    """The Q-network: ReLU hidden layers, then one head (Q) or two (V, A) combined row by row."""
+    if not dueling:
+        return mlp(weights, obs)
+    x = mlp(weights[:-4], obs, final_relu=True)
+    return dueling_combine(x @ weights[-4] + weights[-3], x @ weights[-2] + weights[-1])
+
+
+def actor_probs(weights, obs):
+    """The A2C actor: ReLU hidden layers, softmax over the output row by row."""
+    logits = mlp(weights, obs)
+    out = np.zeros_like(logits)
+    for i, row in enumerate(logits):
+        e = np.exp(row - row.max())
+        out[i] = e / e.sum()
+    return out
+
+
 def squashed_gaussian(mean, log_std, noise):
     """a = tanh(u), u = mean + std * noise; log pi(a) = log N(u) - sum log(1 - tanh(u)^2), naively."""
     std = np.exp(log_std)

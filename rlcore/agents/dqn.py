@@ -15,7 +15,8 @@ from keras import layers
 
 from rlcore.configs import DQNConfig
 from rlcore.layers import DuelingCombine
-from rlcore.models import numpy_relu_trunk, save_keras_model
+from rlcore.models import save_keras_model
+from rlcore.numpy_forward import NumpyForward
 
 
 def build_q_network(obs_dim: int, n_actions: int, hidden=(64, 64), dueling: bool = False,
@@ -32,19 +33,6 @@ def build_q_network(obs_dim: int, n_actions: int, hidden=(64, 64), dueling: bool
     else:
         q_values = layers.Dense(n_actions, name="q_values")(x)
     return keras.Model(obs, q_values, name=name)
-
-
-def numpy_q_values(weights: list[np.ndarray], obs: np.ndarray, dueling: bool) -> np.ndarray:
-    """The Q-network's forward pass in numpy, from ``model.get_weights()`` order.
-
-    Used for fast acting and as the reference the Keras model is tested against.
-    """
-    x = numpy_relu_trunk(weights[:-4 if dueling else -2], obs)
-    if not dueling:
-        return x @ weights[-2] + weights[-1]
-    value = x @ weights[-4] + weights[-3]
-    advantage = x @ weights[-2] + weights[-1]
-    return value + advantage - advantage.mean(axis=-1, keepdims=True)
 
 
 def make_optimizer(cfg: DQNConfig) -> keras.optimizers.Optimizer:
@@ -68,14 +56,13 @@ class DQNAgent:
         self.target_network.set_weights(self.q_network.get_weights())
         self.optimizer = make_optimizer(cfg)
         self.optimizer.build(self.q_network.trainable_variables)
-        self.sync_policy_weights()
+        self.policy = NumpyForward(self.q_network)  # acting's numpy copy, see act()
         self._compiled_updates = {}  # number of stacked minibatches -> tf.function
 
     # ----------------------------------------------------------------- acting
     def greedy_actions(self, obs: np.ndarray) -> np.ndarray:
         """argmax_a Q(s, a) for a batch of observations (numpy forward pass, see below)."""
-        q_values = numpy_q_values(self.policy_weights, np.asarray(obs, np.float32), self.cfg.dueling)
-        return q_values.argmax(axis=1)
+        return self.policy(obs).argmax(axis=1)
 
     def act(self, obs: np.ndarray, epsilon: float, rng: np.random.Generator) -> int:
         """Epsilon-greedy action for one observation.
@@ -89,7 +76,7 @@ class DQNAgent:
 
     def sync_policy_weights(self) -> None:
         """Refresh the numpy copy of the online weights (after loading or restoring)."""
-        self.policy_weights = [np.array(w) for w in self.q_network.get_weights()]
+        self.policy.load(self.q_network.get_weights())
 
     # --------------------------------------------------------------- learning
     def td_target(self, reward, next_obs, terminated):
@@ -150,7 +137,7 @@ class DQNAgent:
     def train_steps(self, obs, action, reward, next_obs, terminated) -> dict[str, float]:
         """Gradient steps on K stacked minibatches (leading axis K); returns mean named losses."""
         losses, weights = self._compiled(len(obs))(obs, action, reward, next_obs, terminated)
-        self.policy_weights = [w.numpy() for w in weights]
+        self.policy.load(weights)
         return {k: float(v) for k, v in losses.items()}
 
     def train_step(self, obs, action, reward, next_obs, terminated) -> dict[str, float]:

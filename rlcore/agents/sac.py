@@ -29,7 +29,8 @@ import tensorflow as tf
 from keras import layers
 
 from rlcore.configs import SACConfig
-from rlcore.models import numpy_relu_trunk, save_keras_model
+from rlcore.models import save_keras_model
+from rlcore.numpy_forward import NumpyForward
 
 ACTOR_FILE = "actor.h5"
 LOG_2PI = math.log(2.0 * math.pi)
@@ -78,7 +79,7 @@ class SACAgent:
         self.actor_opt.build(self.actor.trainable_variables)
         self.critic_opt.build(self._critic_variables())
         self.alpha_opt.build([self.log_alpha])
-        self.sync_policy_weights()
+        self.policy = NumpyForward(self.actor)  # acting's numpy copy of the actor
         k, a, o = cfg.updates_per_call, act_dim, obs_dim
         obs_spec, vec = tf.TensorSpec([k, None, o], tf.float32), tf.TensorSpec([k, None], tf.float32)
         act_spec = tf.TensorSpec([k, None, a], tf.float32)
@@ -91,11 +92,10 @@ class SACAgent:
 
     # ----------------------------------------------------------------- acting
     def sync_policy_weights(self) -> None:
-        self.policy_weights = [np.array(w) for w in self.actor.get_weights()]
+        self.policy.load(self.actor.get_weights())
 
     def mean_and_log_std(self, obs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        out = numpy_relu_trunk(self.policy_weights[:-2], np.asarray(obs, np.float32))
-        out = out @ self.policy_weights[-2] + self.policy_weights[-1]
+        out = self.policy(obs)
         mean, log_std = out[:, :self.act_dim], out[:, self.act_dim:]
         return mean, np.clip(log_std, self.cfg.log_std_min, self.cfg.log_std_max)
 
@@ -169,7 +169,7 @@ class SACAgent:
         bad = [k for k, v in losses.items() if not math.isfinite(v)]
         if bad:  # XLA drops check_numerics, so the check is here, after the call
             raise FloatingPointError(f"SAC {bad[0]} is NaN/Inf")
-        self.policy_weights = [w.numpy() for w in weights]
+        self.policy.load(weights)
         return losses
 
     # ------------------------------------------------------------ persistence

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 import tensorflow as tf
 
-from rlcore.agents.a2c import A2CAgent, Actor, Critic, numpy_actor_probs
+from rlcore.agents.a2c import A2CAgent, Actor, Critic
 from rlcore.agents.advantages import gae
 from rlcore.configs import A2CConfig
 from tests import numpy_reference as ref
@@ -72,8 +72,9 @@ def test_critic_loss_is_mse():
 def test_numpy_actor_matches_keras():
     agent = A2CAgent(OBS, ACTIONS, A2CConfig(actor_hidden=(32, 16)))
     obs = np.random.default_rng(4).normal(size=(7, OBS)).astype(np.float32)
-    np.testing.assert_allclose(numpy_actor_probs(agent.actor.model.get_weights(), obs),
-                               agent.actor.model(obs).numpy(), rtol=1e-4, atol=1e-6)
+    np.testing.assert_allclose(agent.probs(obs), agent.actor.model(obs).numpy(), rtol=1e-4, atol=1e-6)
+    np.testing.assert_allclose(agent.probs(obs), ref.actor_probs(agent.actor.model.get_weights(), obs),
+                               rtol=1e-4, atol=1e-6)
 
 
 def test_sampling_follows_the_policy():

@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 import tensorflow as tf
 
-from rlcore.agents.dqn import DQNAgent, build_q_network, numpy_q_values
+from rlcore.agents.dqn import DQNAgent, build_q_network
+from rlcore.numpy_forward import NumpyForward
 from rlcore.configs import DQNConfig
 from rlcore.errors import UserError
 from rlcore.layers import DuelingCombine
@@ -70,8 +71,9 @@ def test_dueling_combine_matches_numpy():
 def test_keras_forward_matches_numpy_forward(dueling):
     model = build_q_network(OBS, ACTIONS, (32, 16), dueling)
     obs = random_batch()[0]
-    np.testing.assert_allclose(model(obs).numpy(), numpy_q_values(model.get_weights(), obs, dueling),
+    np.testing.assert_allclose(model(obs).numpy(), ref.q_values(model.get_weights(), obs, dueling),
                                rtol=1e-4, atol=1e-5)
+    np.testing.assert_allclose(NumpyForward(model)(obs), model(obs).numpy(), rtol=1e-4, atol=1e-5)
 
 
 def test_update_with_constant_weights_matches_hand_computed_loss():
@@ -96,7 +98,7 @@ def test_update_with_constant_weights_matches_hand_computed_loss():
     np.testing.assert_allclose(new_bias, bias + np.array([1e-3, -1e-3]), rtol=1e-4)
     target_bias = agent.target_network.get_weights()[-1]
     np.testing.assert_allclose(target_bias, 0.9 * bias + 0.1 * new_bias, rtol=1e-5)
-    np.testing.assert_allclose(agent.policy_weights[-1], new_bias)  # acting sees the update
+    np.testing.assert_allclose(agent.policy.weights[-1], new_bias)  # acting sees the update
 
 
 def test_huber_loss_by_hand():

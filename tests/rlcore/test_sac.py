@@ -83,7 +83,7 @@ def test_one_update_matches_numpy_step_by_step():
         for t, b, c in zip(target.get_weights(), before, critic):
             np.testing.assert_allclose(t, CFG.tau * c + (1 - CFG.tau) * b, rtol=1e-5, atol=1e-7)
     # and the numpy acting copy of the actor is the updated actor
-    for w, v in zip(agent.policy_weights, agent.actor.get_weights()):
+    for w, v in zip(agent.policy.weights, agent.actor.get_weights()):
         np.testing.assert_array_equal(w, v)
 
 
