@@ -1,0 +1,49 @@
+"""StopRules (budgets and goals, and which one ended a run) and StopRequest (the stop file)."""
+import dataclasses
+
+from rlcore.configs import EpisodeLoop, PPOConfig
+from rlcore.trainers.episodes import EpisodeBook
+from rlcore.trainers.periodic_eval import PeriodicEvaluation
+from rlcore.trainers.stopping import StopRequest, StopRules
+
+
+def _reason(cfg, returns=(), successes=(), env_steps=0, best_eval=None):
+    book = EpisodeBook(cfg.window, None, list(returns), list(successes))
+    evaluation = PeriodicEvaluation(cfg, {"best_eval": best_eval})
+    return StopRules(cfg).reason(book, env_steps, evaluation)
+
+
+def test_each_rule_names_itself():
+    cfg = EpisodeLoop(max_episodes=5, max_env_steps=100, window=2, stop_score=10.0, stop_eval_score=50.0)
+    assert _reason(cfg) is None
+    assert _reason(cfg, returns=[0] * 5) == "max_episodes 5"
+    assert _reason(cfg, env_steps=100) == "max_env_steps 100"
+    assert _reason(cfg, best_eval={"mean": 50.0}) == "stop_eval_score 50.0"
+    assert _reason(cfg, best_eval={"mean": 49.9}) is None
+    assert _reason(cfg, returns=[9, 11]) == "stop_score 10.0"  # mean of the last 2 is 10
+    assert _reason(cfg, returns=[11]) is None  # the window is not full yet
+
+
+def test_success_share_needs_a_full_window():
+    cfg = PPOConfig(window=4, stop_success_share=0.75, stop_score=1e9, max_episodes=100)
+    assert _reason(cfg, returns=[0] * 3, successes=[True] * 3) is None
+    assert _reason(cfg, returns=[0] * 4, successes=[True, False, True, True]) == "stop_success_share 0.75"
+    assert _reason(cfg, returns=[0] * 4, successes=[True, False, False, True]) is None
+    assert _reason(dataclasses.replace(cfg, stop_success_share=0.0), returns=[0] * 4, successes=[True] * 4) is None
+
+
+def test_stop_file_is_seen_and_stays_seen(tmp_path, monkeypatch):
+    monkeypatch.setattr(StopRequest, "FILE_CHECK_SECONDS", 0.0)
+    stop = StopRequest(tmp_path / "STOP")
+    assert not stop.poll()
+    (tmp_path / "STOP").touch()
+    assert stop.poll()
+    (tmp_path / "STOP").unlink()
+    assert stop.poll()  # once asked, the run stops at its next safe point
+
+
+def test_without_a_stop_file_only_ctrl_c_stops():
+    stop = StopRequest(None)
+    assert not stop.poll()
+    stop.requested = True
+    assert stop.poll()
