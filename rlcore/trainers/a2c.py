@@ -9,12 +9,11 @@ import numpy as np
 import tensorflow as tf
 
 from rlcore.agents.a2c import A2CAgent
-from rlcore.checkpoint import load_checkpoint, save_checkpoint
 from rlcore.errors import UserError
+from rlcore.trainers import checkpoints
 from rlcore.trainers.session import TrainingSession
-from rlcore.trainers.spec import RunSpec, check_resumable
+from rlcore.trainers.spec import RunSpec
 from rlcore.vector import EnvPool, bootstrap_observations
-from rlcore.seeding import training_env_seed
 
 
 def train(spec: RunSpec) -> Path:
@@ -26,18 +25,11 @@ def train(spec: RunSpec) -> Path:
     agent = A2CAgent(obs_dim, n_actions, cfg)
     rng = np.random.default_rng(spec.seed)
 
-    state = check_resumable(spec) if spec.resume else None
-    if state is not None:
-        state, arrays = load_checkpoint(spec.run_dir / "checkpoint.npz", agent.models(), agent.optimizers())
-        rng.bit_generator.state = state["rng"]
-        agent.sync_policy_weights()
-    session = TrainingSession(spec, state)
-    if state is not None:
-        session.restore_best_arrays(arrays)
+    state, arrays = checkpoints.restore(spec, agent, rng)
+    session = TrainingSession(spec, state, resumed_arrays=arrays)
 
     def checkpoint():
-        save_checkpoint(session.checkpoint_path, agent.models(), agent.optimizers(),
-                        session.state(rng=rng.bit_generator.state), session.best_arrays())
+        checkpoints.save(session, agent, rng)
 
     t, n = cfg.n_steps, cfg.num_envs
     buf_obs = np.zeros((t, n, obs_dim), np.float32)
@@ -47,7 +39,7 @@ def train(spec: RunSpec) -> Path:
     running = np.zeros(n)
     losses = {"actor_loss": float("nan"), "critic_loss": float("nan"), "entropy": float("nan")}
     # a resumed run starts fresh episodes, reseeded from its episode count
-    obs, _ = envs.reset(seed=[training_env_seed(spec.seed, session.book.episodes + i) for i in range(n)])
+    obs, _ = envs.reset(seed=session.fresh_env_seeds(n))
     next_checkpoint = (session.book.episodes // cfg.checkpoint_every + 1) * cfg.checkpoint_every
     with envs, session.interruptible():
         while not session.should_stop():

@@ -11,10 +11,9 @@ import tensorflow as tf
 from rlcore.agents.dqn import DQNAgent
 from rlcore.errors import UserError
 from rlcore.replay import ReplayMemory
-from rlcore.trainers import replay_io
+from rlcore.trainers import checkpoints
 from rlcore.trainers.session import TrainingSession
 from rlcore.trainers.spec import RunSpec
-from rlcore.seeding import training_env_seed
 
 
 def train(spec: RunSpec) -> Path:
@@ -28,20 +27,18 @@ def train(spec: RunSpec) -> Path:
     rng = np.random.default_rng(spec.seed)
     epsilon = cfg.eps_start
 
-    state, arrays = replay_io.resume(spec, agent, memory, rng)
+    state, arrays = checkpoints.restore(spec, agent, rng, memory)
     if state is not None:
         epsilon = state["epsilon"]
-        agent.sync_policy_weights()
-    session = TrainingSession(spec, state)
-    session.restore_best_arrays(arrays)
+    session = TrainingSession(spec, state, resumed_arrays=arrays)
     grad_steps = int(state["grad_steps"]) if state else 0
 
     def checkpoint():
-        replay_io.save(session, agent, memory, rng, epsilon=epsilon, grad_steps=grad_steps)
+        checkpoints.save(session, agent, rng, memory, epsilon=epsilon, grad_steps=grad_steps)
 
     update_period = cfg.learn_every * cfg.updates_per_call
     # a resumed run reseeds from its episode count
-    first_seed = training_env_seed(spec.seed, session.book.episodes)
+    first_seed = session.fresh_env_seeds(1)[0]
     with session.interruptible():
         while not session.should_stop():
             obs, _ = env.reset(seed=first_seed)

@@ -15,12 +15,11 @@ import tensorflow as tf
 from tqdm import tqdm
 
 from rlcore.agents.ppo import LOSS_NAMES, MODEL_FILE, PPOAgent
-from rlcore.checkpoint import load_checkpoint, save_checkpoint
 from rlcore.errors import UserError
+from rlcore.trainers import checkpoints
 from rlcore.trainers.session import TrainingSession
-from rlcore.trainers.spec import RunSpec, check_resumable
+from rlcore.trainers.spec import RunSpec
 from rlcore.vector import EnvPool
-from rlcore.seeding import training_env_seed
 
 
 def _final(infos: dict, key: str, i: int, default=0):
@@ -64,10 +63,8 @@ def train(spec: RunSpec) -> Path:
     rng = np.random.default_rng(spec.seed)
     success_key, progress_key = exp.success_key, exp.progress_key
 
-    state = check_resumable(spec) if spec.resume else None
+    state, _ = checkpoints.restore(spec, agent, rng)
     if state is not None:
-        state, _ = load_checkpoint(spec.run_dir / "checkpoint.npz", agent.models(), agent.optimizers())
-        rng.bit_generator.state = state["rng"]
         parent = state.get("init_from")
     else:
         parent = init_weights(agent, cfg.init_from, exp.name, spec.algo) if cfg.init_from else None
@@ -76,15 +73,14 @@ def train(spec: RunSpec) -> Path:
     rollouts = int(state.get("rollouts", 0)) if state else 0
 
     def checkpoint():
-        save_checkpoint(session.checkpoint_path, agent.models(), agent.optimizers(),
-                        session.state(rng=rng.bit_generator.state, rollouts=rollouts, init_from=parent))
+        checkpoints.save(session, agent, rng, rollouts=rollouts, init_from=parent)
 
     t, n = cfg.n_steps, cfg.num_envs
     buf = Rollout(t, n, obs_shape)
     running = np.zeros(n)
     losses = {name: float("nan") for name in LOSS_NAMES}  # CSV columns exist from the first row
     # a resumed run starts fresh episodes, reseeded from its episode count
-    obs, _ = envs.reset(seed=[training_env_seed(spec.seed, book.episodes + i) for i in range(n)])
+    obs, _ = envs.reset(seed=session.fresh_env_seeds(n))
     with envs, session.interruptible():
         while not session.should_stop():
             max_x, min_x, ended, flags = -np.inf, np.inf, 0, 0

@@ -13,11 +13,12 @@ It puts together the parts that each own one thing:
 and holds the run's counters (env steps, wall time, commands), which it writes into every
 checkpoint's state and restores from it. A trainer reads like its article's loop::
 
-    session = TrainingSession(spec, resumed_state)
+    state, arrays = checkpoints.restore(spec, agent, rng, memory)
+    session = TrainingSession(spec, state, resumed_arrays=arrays)
     with session.interruptible():
         while not session.should_stop():
             ...; session.env_steps += n; ...; session.end_episode(ret, extra)
-    checkpoint()
+    checkpoints.save(session, agent, rng, memory, grad_steps=...)
     if session.stop_requested: raise session.interrupted()
     return session.finish(agent.save)
 """
@@ -27,6 +28,7 @@ import sys
 import time
 from pathlib import Path
 
+from rlcore.seeding import training_env_seed
 from rlcore.tracking import Tracker
 from rlcore.trainers.episodes import EpisodeBook
 from rlcore.trainers.model_folder import write_model_folder
@@ -37,7 +39,8 @@ from rlcore.trainers.stopping import Interrupted, StopRequest, StopRules
 
 
 class TrainingSession:
-    def __init__(self, spec: RunSpec, resumed_state: dict | None = None, progress_unit: str = "episode"):
+    def __init__(self, spec: RunSpec, resumed_state: dict | None = None, progress_unit: str = "episode",
+                 resumed_arrays: dict | None = None):
         self.spec = spec
         cfg = spec.config
         self.run_dir = spec.run_dir
@@ -51,6 +54,7 @@ class TrainingSession:
         # the command that started the run, then one per resume
         self.commands = list(state.get("commands", [])) + [spec.command]
         self.evaluation = PeriodicEvaluation(cfg, state)
+        self.evaluation.restore_best_arrays(resumed_arrays or {})
         self.stop = StopRequest(spec.stop_file)
         self.rules = StopRules(cfg)
         self.stop_reason: str | None = None
@@ -64,6 +68,11 @@ class TrainingSession:
         self.progress = Progress(progress_unit, cfg, self.book.episodes, self.env_steps, spec.progress)
 
     # ------------------------------------------------------------ the loop's calls
+    def fresh_env_seeds(self, n: int) -> list[int]:
+        """Seeds for ``n`` envs starting new episodes now: from the run's seed and its episode count,
+        so a resumed run reseeds where it stopped (``rlcore.seeding``)."""
+        return [training_env_seed(self.spec.seed, self.book.episodes + i) for i in range(n)]
+
     def elapsed(self) -> float:
         return self._wall_before + time.perf_counter() - self._started
 
@@ -121,9 +130,6 @@ class TrainingSession:
 
     def best_arrays(self) -> dict:
         return self.evaluation.best_arrays()
-
-    def restore_best_arrays(self, arrays: dict) -> None:
-        self.evaluation.restore_best_arrays(arrays)
 
     # ------------------------------------------------------------- the end
     def finish(self, save_models, load_weights=None, **record) -> Path:
