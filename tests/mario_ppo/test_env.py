@@ -149,3 +149,20 @@ def test_gray_of_the_emulator_screen_view_equals_cv2_on_a_contiguous_copy(env):
         want = cv2.resize(cv2.cvtColor(np.ascontiguousarray(screen), cv2.COLOR_RGB2GRAY),
                           (FRAME_SIZE, FRAME_SIZE))
         np.testing.assert_array_equal(gray_84(screen), want)
+
+
+def test_reward_and_stall_options_reach_the_env_from_the_config():
+    import dataclasses
+
+    from mario_ppo.experiment import EXPERIMENT
+
+    cfg = dataclasses.replace(EXPERIMENT.preset("ppo", "default"), stall_steps=7, score_reward=0.025)
+    env = EXPERIMENT.env_factory(cfg)()  # what the pool's workers and a saved model's policy build
+    try:
+        assert isinstance(env, StallLimit) and env.steps == 7
+        assert env.get_wrapper_attr("score_reward") == 0.025
+    finally:
+        env.close()
+    plain = EXPERIMENT.env_factory(EXPERIMENT.preset("ppo", "default"))()
+    assert not isinstance(plain, StallLimit) and plain.get_wrapper_attr("score_reward") == 0.0
+    plain.close()
