@@ -167,6 +167,8 @@ class SACConfig(EpisodeLoop):
                                   "env steps (one env step per gradient step either way)", COUNT)
     log_std_min: float = _h(-20.0, "lower clip of the actor's log standard deviation", FINITE)
     log_std_max: float = _h(2.0, "upper clip of the actor's log standard deviation", FINITE)
+    obs_norm: bool = _h(False, "standardize observations with the running mean and std of every "
+                               "observation so far (clipped to +-10), kept inside the saved networks")
 
     def __post_init__(self):
         super().__post_init__()

@@ -5,7 +5,8 @@ same small MLP in numpy takes ~0.03 ms. :class:`NumpyForward` walks the model's 
 construction, into a list of numpy steps, so a change to a network needs no second, hand-written
 copy. The training step hands back the new weights (``load``), and acting sees them at once.
 
-Layers it knows: ``Dense`` (relu, tanh, softmax or linear) and our ``DuelingCombine``; any other
+Layers it knows: ``Dense`` (relu, tanh, softmax or linear), our ``DuelingCombine`` and
+``Standardize``; any other
 layer is refused when the forward pass is built, not silently mis-computed.
 """
 from __future__ import annotations
@@ -13,7 +14,7 @@ from __future__ import annotations
 import keras
 import numpy as np
 
-from rlcore.layers import DuelingCombine
+from rlcore.layers import DuelingCombine, Standardize
 
 
 def _softmax(x: np.ndarray) -> np.ndarray:
@@ -39,7 +40,14 @@ def _dueling(layer):
     return combine
 
 
-STEPS = {keras.layers.Dense: _dense, DuelingCombine: _dueling}
+def _standardize(layer):
+    def standardize(weights, x):
+        mean, var = weights
+        return np.clip((x - mean) / np.sqrt(var + layer.EPS), -layer.clip, layer.clip)
+    return standardize
+
+
+STEPS = {keras.layers.Dense: _dense, DuelingCombine: _dueling, Standardize: _standardize}
 
 
 class NumpyForward:

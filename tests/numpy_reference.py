@@ -137,3 +137,13 @@ def sac_actor_and_alpha_loss(actor_w, critic_ws, log_alpha, obs, noise, target_e
     actor = np.mean(np.exp(log_alpha) * logp - q)
     alpha = -np.mean(log_alpha * (logp + target_entropy))
     return actor, alpha
+
+
+def standardize(obs, mean, var, clip, eps=1e-8):
+    """(obs - mean) / sqrt(var + eps), each element clipped to [-clip, clip]."""
+    out = np.zeros_like(obs, dtype=np.float64)
+    for i in range(obs.shape[0]):
+        for j in range(obs.shape[1]):
+            z = (obs[i, j] - mean[j]) / np.sqrt(var[j] + eps)
+            out[i, j] = min(max(z, -clip), clip)
+    return out

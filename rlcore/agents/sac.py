@@ -29,26 +29,30 @@ import tensorflow as tf
 from keras import layers
 
 from rlcore.configs import SACConfig
+from rlcore.layers import Standardize
 from rlcore.models import save_keras_model
 from rlcore.numpy_forward import NumpyForward
+from rlcore.running_stats import RunningMeanStd
 
 ACTOR_FILE = "actor.h5"
 LOG_2PI = math.log(2.0 * math.pi)
 
 
-def build_actor(obs_dim: int, act_dim: int, hidden) -> keras.Model:
-    """obs -> ReLU MLP -> [mean (act_dim), log_std (act_dim)] concatenated."""
+def build_actor(obs_dim: int, act_dim: int, hidden, standardize: Standardize | None = None) -> keras.Model:
+    """obs -> (standardize) -> ReLU MLP -> [mean (act_dim), log_std (act_dim)] concatenated."""
     return keras.Sequential(
-        [keras.Input((obs_dim,), name="obs")]
+        [keras.Input((obs_dim,), name="obs")] + ([standardize] if standardize is not None else [])
         + [layers.Dense(u, activation="relu", name=f"hidden_{i}") for i, u in enumerate(hidden)]
         + [layers.Dense(2 * act_dim, name="mean_and_log_std")], name="actor")
 
 
-def build_critic(obs_dim: int, act_dim: int, hidden, name: str) -> keras.Model:
-    """Q(s, a): the state and the action concatenated, then a ReLU MLP."""
+def build_critic(obs_dim: int, act_dim: int, hidden, name: str,
+                 standardize: Standardize | None = None) -> keras.Model:
+    """Q(s, a): the (standardized) state and the action concatenated, then a ReLU MLP."""
     obs = keras.Input((obs_dim,), name="obs")
     action = keras.Input((act_dim,), name="action")
-    x = layers.Concatenate(name="state_action")([obs, action])
+    state = standardize(obs) if standardize is not None else obs
+    x = layers.Concatenate(name="state_action")([state, action])
     for i, u in enumerate(hidden):
         x = layers.Dense(u, activation="relu", name=f"hidden_{i}")(x)
     return keras.Model([obs, action], layers.Dense(1, name="q")(x), name=name)
@@ -67,9 +71,14 @@ class SACAgent:
     def __init__(self, obs_dim: int, act_dim: int, cfg: SACConfig):
         self.obs_dim, self.act_dim, self.cfg = obs_dim, act_dim, cfg
         self.target_entropy = cfg.target_entropy or -float(act_dim)
-        self.actor = build_actor(obs_dim, act_dim, cfg.actor_hidden)
-        self.critics = [build_critic(obs_dim, act_dim, cfg.critic_hidden, f"critic_{j}") for j in (1, 2)]
-        self.targets = [build_critic(obs_dim, act_dim, cfg.critic_hidden, f"target_critic_{j}") for j in (1, 2)]
+        # with obs_norm, one Standardize layer (its mean and var) is shared by all five networks
+        self.standardize = Standardize(name="standardize") if cfg.obs_norm else None
+        self.obs_stats = RunningMeanStd(obs_dim) if cfg.obs_norm else None
+        self.actor = build_actor(obs_dim, act_dim, cfg.actor_hidden, self.standardize)
+        self.critics = [build_critic(obs_dim, act_dim, cfg.critic_hidden, f"critic_{j}", self.standardize)
+                        for j in (1, 2)]
+        self.targets = [build_critic(obs_dim, act_dim, cfg.critic_hidden, f"target_critic_{j}", self.standardize)
+                        for j in (1, 2)]
         for target, critic in zip(self.targets, self.critics):
             target.set_weights(critic.get_weights())
         self.log_alpha = tf.Variable(math.log(cfg.init_alpha), dtype=tf.float32, name="log_alpha")
@@ -159,8 +168,20 @@ class SACAgent:
         means = {k: tf.reduce_mean(tf.stack([h[k] for h in history])) for k in history[0]}
         return means, self.actor.weights
 
+    def observe(self, obs: np.ndarray) -> None:
+        """Fold observations into the running statistics (``obs_norm``; else nothing)."""
+        if self.obs_stats is not None:
+            self.obs_stats.update(obs)
+
+    def _push_obs_stats(self) -> None:
+        """The running statistics into the networks' Standardize layer (before each update)."""
+        if self.obs_stats is not None:
+            self.standardize.mean.assign(self.obs_stats.mean.astype(np.float32))
+            self.standardize.var.assign(self.obs_stats.var.astype(np.float32))
+
     def train_steps(self, obs, action, reward, next_obs, terminated, rng: np.random.Generator) -> dict:
         """``updates_per_call`` gradient steps on stacked minibatches (leading axis K)."""
+        self._push_obs_stats()
         noise_shape = (*np.shape(action),)
         next_noise = rng.standard_normal(noise_shape).astype(np.float32)
         noise = rng.standard_normal(noise_shape).astype(np.float32)

@@ -13,6 +13,7 @@ import numpy as np
 from rlcore.agents.sac import SACAgent
 from rlcore.errors import UserError
 from rlcore.replay import ReplayMemory
+from rlcore.running_stats import RunningMeanStd
 from rlcore.trainers import checkpoints
 from rlcore.trainers.session import TrainingSession
 from rlcore.trainers.spec import RunSpec
@@ -30,12 +31,15 @@ def train(spec: RunSpec) -> Path:
     state, arrays = checkpoints.restore(spec, agent, rng, memory)
     if state is not None:
         agent.log_alpha.assign(state["log_alpha"])
+        if agent.obs_stats is not None:
+            agent.obs_stats = RunningMeanStd(obs_dim, state["obs_stats"])
     session = TrainingSession(spec, state, resumed_arrays=arrays)
     grad_steps = int(state["grad_steps"]) if state else 0
 
     def checkpoint():
         checkpoints.save(session, agent, rng, memory, grad_steps=grad_steps,
-                       log_alpha=float(agent.log_alpha.numpy()))
+                         log_alpha=float(agent.log_alpha.numpy()),
+                         obs_stats=agent.obs_stats.state() if agent.obs_stats is not None else None)
 
     k = cfg.updates_per_call
     # a resumed run reseeds from its episode count
@@ -43,6 +47,7 @@ def train(spec: RunSpec) -> Path:
     with session.interruptible():
         while not session.should_stop():
             obs, _ = env.reset(seed=first_seed)
+            agent.observe(obs)
             first_seed = None  # later episodes continue the env's own RNG
             episode_return, losses = 0.0, []
             while True:
@@ -52,6 +57,7 @@ def train(spec: RunSpec) -> Path:
                     action = agent.act(obs[None], rng)[0]
                 next_obs, reward, terminated, truncated, _ = env.step(action)
                 memory.add(obs, action, reward, next_obs, terminated)
+                agent.observe(next_obs)
                 session.env_steps += 1
                 episode_return += reward
                 obs = next_obs
