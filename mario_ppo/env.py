@@ -84,12 +84,13 @@ class ArticleShaping(gym.Wrapper):
 
     Only a real end (``terminated``) is shaped; a time-limit truncation is not an outcome.
     """
+    END_BONUS, SCALE = 50.0, 10.0
 
     def step(self, action):
         obs, reward, terminated, truncated, info = self.env.step(action)
         if terminated:
-            reward += 50.0 if info["flag_get"] else -50.0
-        return obs, reward / 10.0, terminated, truncated, info
+            reward += self.END_BONUS if info["flag_get"] else -self.END_BONUS
+        return obs, reward / self.SCALE, terminated, truncated, info
 
 
 def gray_84(frame: np.ndarray) -> np.ndarray:
@@ -150,17 +151,23 @@ class SkipAndStack(gym.Wrapper):
 
 
 class StallLimit(gym.Wrapper):
-    """Truncate the episode once Mario's x has not passed its best for ``steps`` agent steps.
+    """End the episode once Mario's x has not passed its best for ``steps`` agent steps.
 
     Seen on 1-2: a policy that jumps onto a ledge below a wall pushes right against the wall until
     the clock runs out (about 1,500 agent steps), so a rollout of 8 x 512 steps held 2-4 episodes,
-    nearly all of them at that wall. A truncation is not an outcome: PPO bootstraps it from V, as
-    any time limit, and the env starts a new episode.
-    """
+    nearly all of them at that wall.
 
-    def __init__(self, env: gym.Env, steps: int):
+    ``outcome="truncate"``: a truncation, not an outcome; PPO bootstraps it from V, as any time
+    limit. ``outcome="death"``: the end the clock would bring to a Mario that stays stuck, a
+    termination with the article's end penalty (-50 / 10). Bootstrapping from V kept the ledge
+    attractive on 1-2 (V there predicts the progress of the states that look like it); as a death,
+    standing still has the value it has in the game.
+    """
+    OUTCOMES = ("truncate", "death")
+
+    def __init__(self, env: gym.Env, steps: int, outcome: str = "truncate"):
         super().__init__(env)
-        self.steps = steps
+        self.steps, self.as_death = steps, outcome == "death"
 
     def reset(self, *, seed=None, options=None):
         obs, info = self.env.reset(seed=seed, options=options)
@@ -173,8 +180,10 @@ class StallLimit(gym.Wrapper):
             self._best, self._since = info["x_pos"], 0
         else:
             self._since += 1
-        info["stalled"] = self._since >= self.steps
-        return obs, reward, terminated, truncated or info["stalled"], info
+        info["stalled"] = stalled = self._since >= self.steps and not (terminated or truncated)
+        if stalled and self.as_death:
+            return obs, reward - ArticleShaping.END_BONUS / ArticleShaping.SCALE, True, truncated, info
+        return obs, reward, terminated, truncated or stalled, info
 
 
 def _trim(info: dict) -> dict:
@@ -183,10 +192,11 @@ def _trim(info: dict) -> dict:
 
 def make_env(render_mode: str | None = None, max_episode_steps: int | None = None, world: int = 1,
              stage: int = 1, actions: str = "simple", skip: int = 4, score_reward: float = 0.0,
-             stall_steps: int = 0) -> gym.Env:
+             stall_steps: int = 0, stall_outcome: str = "truncate") -> gym.Env:
     """The article's Mario env for one stage. ``max_episode_steps`` counts agent steps (None = none);
     ``score_reward``: reward per game-score point (0 = the article's reward); ``stall_steps``: end
-    an episode (as a truncation) after this many agent steps without a new best x (0 = never)."""
+    an episode after this many agent steps without a new best x (0 = never), as a truncation or as a
+    death (``stall_outcome``)."""
     import gym_super_mario_bros  # noqa: F401  registers the SuperMarioBros-* ids
     from nes_py.wrappers import JoypadSpace
 
@@ -198,7 +208,7 @@ def make_env(render_mode: str | None = None, max_episode_steps: int | None = Non
     env = JoypadSpace(env, action_list(actions))
     env = SkipAndStack(ArticleShaping(ClassicReward(env, score_reward)), skip)
     if stall_steps:
-        env = StallLimit(env, stall_steps)
+        env = StallLimit(env, stall_steps, stall_outcome)
     if max_episode_steps:
         env = gym.wrappers.TimeLimit(env, max_episode_steps)
     return env

@@ -120,6 +120,16 @@ def test_stall_limit_truncates_after_steps_without_a_new_best_x():
     assert not any(s[2] for s in steps)  # a truncation, never a termination (PPO bootstraps it)
 
 
+def test_a_stall_can_end_as_a_death_with_the_end_penalty():
+    xs = [100, 101, 101, 101, 101]
+    env = StallLimit(_ScriptedInfos([(x, 400, 0, False) for x in xs]), steps=3, outcome="death")
+    env.reset()
+    steps = [env.step(0) for _ in xs[1:]]
+    assert [s[2] for s in steps] == [False, False, False, True] and not any(s[3] for s in steps)
+    assert steps[-1][1] == 123.0 - 5.0  # the stand-in's reward, then -50 / 10 as at any other death
+    assert steps[0][1] == 123.0
+
+
 def test_unknown_level_and_action_set_are_clear_errors():
     with pytest.raises(UserError, match="no level 9-1"):
         make_env(world=9)
