@@ -110,6 +110,9 @@ class PPOAgent:
         logp = np.log(np.maximum(probs[np.arange(len(actions)), actions], 1e-12))
         return actions, logp.astype(np.float32), values.astype(np.float32)
 
+    def sync_policy_weights(self) -> None:
+        """Nothing to refresh: PPO acts through the compiled model itself (a CNN is no job for numpy)."""
+
     def values(self, obs: np.ndarray) -> np.ndarray:
         return self.policy_and_values(obs)[1]
 

@@ -74,6 +74,7 @@ class SACAgent:
         # with obs_norm, one Standardize layer (its mean and var) is shared by all five networks
         self.standardize = Standardize(name="standardize") if cfg.obs_norm else None
         self.obs_stats = RunningMeanStd(obs_dim) if cfg.obs_norm else None
+        self._unseen: list[np.ndarray] = []  # observations not yet folded into obs_stats
         self.actor = build_actor(obs_dim, act_dim, cfg.actor_hidden, self.standardize)
         self.critics = [build_critic(obs_dim, act_dim, cfg.critic_hidden, f"critic_{j}", self.standardize)
                         for j in (1, 2)]
@@ -169,13 +170,31 @@ class SACAgent:
         return means, self.actor.weights
 
     def observe(self, obs: np.ndarray) -> None:
-        """Fold observations into the running statistics (``obs_norm``; else nothing)."""
+        """Keep an observation for the running statistics (``obs_norm``; else nothing). It is
+        folded in with the others at the next update or checkpoint, not once per env step."""
         if self.obs_stats is not None:
-            self.obs_stats.update(obs)
+            self._unseen.append(obs)
+
+    def obs_stats_state(self) -> dict | None:
+        """The running statistics with every observation so far, for a checkpoint."""
+        if self.obs_stats is None:
+            return None
+        self._fold_unseen()
+        return self.obs_stats.state()
+
+    def restore_obs_stats(self, state: dict | None) -> None:
+        if self.obs_stats is not None:
+            self.obs_stats, self._unseen = RunningMeanStd(self.obs_dim, state), []
+
+    def _fold_unseen(self) -> None:
+        if self._unseen:
+            self.obs_stats.update(np.stack(self._unseen))
+            self._unseen = []
 
     def _push_obs_stats(self) -> None:
         """The running statistics into the networks' Standardize layer (before each update)."""
         if self.obs_stats is not None:
+            self._fold_unseen()
             self.standardize.mean.assign(self.obs_stats.mean.astype(np.float32))
             self.standardize.var.assign(self.obs_stats.var.astype(np.float32))
 

@@ -22,8 +22,7 @@ def restore(spec: RunSpec, agent, rng: np.random.Generator,
     if memory is not None:
         memory.load_state_dict({k[len("replay/"):]: v for k, v in arrays.items() if k.startswith("replay/")})
     rng.bit_generator.state = state["rng"]
-    if hasattr(agent, "sync_policy_weights"):  # agents that act through a numpy copy
-        agent.sync_policy_weights()
+    agent.sync_policy_weights()  # the numpy acting copy, where the agent keeps one
     return state, arrays
 
 

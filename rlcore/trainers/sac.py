@@ -13,7 +13,6 @@ import numpy as np
 from rlcore.agents.sac import SACAgent
 from rlcore.errors import UserError
 from rlcore.replay import ReplayMemory
-from rlcore.running_stats import RunningMeanStd
 from rlcore.trainers import checkpoints
 from rlcore.trainers.session import TrainingSession
 from rlcore.trainers.spec import RunSpec
@@ -31,15 +30,14 @@ def train(spec: RunSpec) -> Path:
     state, arrays = checkpoints.restore(spec, agent, rng, memory)
     if state is not None:
         agent.log_alpha.assign(state["log_alpha"])
-        if agent.obs_stats is not None:
-            agent.obs_stats = RunningMeanStd(obs_dim, state["obs_stats"])
+        agent.restore_obs_stats(state.get("obs_stats"))
     session = TrainingSession(spec, state, resumed_arrays=arrays)
     grad_steps = int(state["grad_steps"]) if state else 0
 
     def checkpoint():
         checkpoints.save(session, agent, rng, memory, grad_steps=grad_steps,
                          log_alpha=float(agent.log_alpha.numpy()),
-                         obs_stats=agent.obs_stats.state() if agent.obs_stats is not None else None)
+                         obs_stats=agent.obs_stats_state())
 
     k = cfg.updates_per_call
     # a resumed run reseeds from its episode count
