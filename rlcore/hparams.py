@@ -18,7 +18,7 @@ def _parse_bool(text: str) -> bool:
         return True
     if lowered in ("0", "false", "no", "off"):
         return False
-    raise ValueError(f"expected true/false, got {text!r}")
+    raise argparse.ArgumentTypeError(f"{text!r} is invalid: allowed is true or false (also 1/0, yes/no, on/off)")
 
 
 def _parser_for(annotation) -> typing.Callable[[str], object]:

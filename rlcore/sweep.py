@@ -16,6 +16,7 @@ Local Ray is started here with a fixed CPU count, no dashboard and every service
 """
 from __future__ import annotations
 
+import argparse
 import itertools
 import json
 import os
@@ -111,7 +112,7 @@ def parse_grid(items: list[str], config) -> dict[str, list]:
             # tuple fields (hidden sizes) take ';' between values: --grid hidden=64,64;128,128
             sep_values = values.split(";") if isinstance(getattr(config, name), tuple) else values.split(",")
             grid[name] = [types[name](v.strip()) for v in sep_values if v.strip()]
-        except ValueError as exc:
+        except (ValueError, argparse.ArgumentTypeError) as exc:  # the latter: a bad true/false
             raise UserError(f"--grid {item!r} is invalid: {exc}") from None
     return grid
 

@@ -56,6 +56,7 @@ BAD_VALUES = [
     (["render", "lunar_lander", "dqn", "--fps", "0"], "argument --fps: 0 is invalid"),
     (["render", "lunar_lander", "dqn", "--episodes", "0"], "argument --episodes: 0 is invalid"),
     (["render", "lunar_lander", "dqn", "--seed", "x"], "argument --seed: 'x' is not a whole number"),
+    (["train", "minitaur", "sac", "--obs-norm", "maybe"], "argument --obs-norm: 'maybe' is invalid: allowed is true or false"),
     # PPO offers no flag it would ignore
     (["train", "mario_ppo", "ppo", "--keep-best", "true"], "unrecognized arguments: --keep-best"),
     (["train", "mario_ppo", "ppo", "--eval-every-steps", "1000"], "unrecognized arguments: --eval-every-steps"),

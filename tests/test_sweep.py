@@ -153,6 +153,7 @@ def test_seeds_and_grid_parsing():
     (["sweep", "lunar_lander", "dqn", "--grid", "learning_rate=1e-3"], "'learning_rate' is not a hyperparameter"),
     (["sweep", "lunar_lander", "dqn", "--grid", "gamma=0.9,1.5"], "--gamma 1.5 is invalid"),
     (["sweep", "lunar_lander", "dqn", "--grid", "lr=fast"], "--grid 'lr=fast' is invalid"),
+    (["sweep", "lunar_lander", "dqn", "--grid", "keep_best=maybe"], "--grid 'keep_best=maybe' is invalid: 'maybe'"),
     (["sweep", "lunar_lander", "dqn", "--seeds", "4-x"], "--seeds '4-x' is invalid"),
     (["report", "/nonexistent/sweep"], "no sweep folder /nonexistent/sweep"),
 ])
