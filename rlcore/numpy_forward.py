@@ -22,12 +22,15 @@ def _softmax(x: np.ndarray) -> np.ndarray:
     return e / e.sum(axis=-1, keepdims=True)
 
 
-ACTIVATIONS = {"relu": lambda x: np.maximum(x, 0.0), "linear": lambda x: x, "tanh": np.tanh,
-               "softmax": _softmax}
+ACTIVATIONS = {"relu": lambda x: np.maximum(x, 0.0), "tanh": np.tanh, "softmax": _softmax}
 
 
 def _dense(layer):
     name = layer.activation.__name__
+    if name == "linear":  # the common heads: no activation call at all
+        return lambda weights, x: x @ weights[0] + weights[1]
+    if name == "relu":
+        return lambda weights, x: np.maximum(x @ weights[0] + weights[1], 0.0)
     if name not in ACTIVATIONS:
         raise NotImplementedError(f"NumpyForward: Dense activation {name!r} of layer {layer.name!r}")
     activation = ACTIVATIONS[name]
@@ -82,11 +85,12 @@ class NumpyForward:
         """New weights, in ``model.get_weights()`` (= ``model.weights``) order; tensors are copied."""
         weights = [np.array(w) for w in weights]
         self.weights = weights
-        self._layer_weights = [weights[part] for _, _, part in self._steps]
+        self._plan = [(step, inputs, weights[part]) for step, inputs, part in self._steps]
 
     def __call__(self, obs: np.ndarray):
         values = [np.asarray(obs, np.float32)]
-        for (step, inputs, _), weights in zip(self._steps, self._layer_weights):
-            values.append(step(weights, *(values[i] for i in inputs)))
-        outputs = [values[i] for i in self._outputs]
-        return outputs[0] if len(outputs) == 1 else outputs
+        for step, inputs, weights in self._plan:
+            values.append(step(weights, *[values[i] for i in inputs]))
+        if len(self._outputs) == 1:
+            return values[self._outputs[0]]
+        return [values[i] for i in self._outputs]
