@@ -7,7 +7,9 @@ Stack, innermost first::
     ClassicReward                            the reward gym-super-mario-bros had before 9.x
                                              (+ game score x score_reward, off by default)
     ArticleShaping                           +50 flag / -50 other ends, then / 10
-    SkipAndStack(4)                          one action for 4 frames, gray 84x84 frames as channels
+    SkipAndStack(4) | SkipAndHistory(4)      one action for 4 frames; as channels, gray 84x84 frames:
+                                             the step's 4 (article 001) or one per step for the
+                                             last 4 steps (uvipen's), ``frames="history"``
     StallLimit(n)                            truncate once x has not passed its best for n agent
                                              steps (off by default)
 
@@ -30,6 +32,7 @@ import gymnasium as gym
 import numpy as np
 
 ACTION_SETS = ("simple", "complex", "right_only")
+FRAME_STACKS = ("skipped", "history")
 FRAME_SIZE = 84
 INFO_KEYS = ("x_pos", "flag_get", "time", "world", "stage")  # what the wrappers pass on
 
@@ -150,6 +153,39 @@ class SkipAndStack(gym.Wrapper):
         return obs, total, terminated, truncated, _trim(info)
 
 
+class SkipAndHistory(SkipAndStack):
+    """Repeat each action for ``skip`` frames; observe the last ``skip`` agent steps, one channel each:
+    the pixel-wise max of the gray frames of the step's second half (uvipen's PyTorch original).
+
+    The max keeps sprites that the NES draws on alternate frames. The stack spans 4 agent steps (16
+    frames) instead of one: a Mario standing still for several steps (against a pipe, holding A,
+    which does not jump again until released) looks different from one that has just landed, so a
+    policy can act differently in the two. Only the pooled half of each step is converted to gray.
+    If the episode ends before the pooled half, the last frame is the step's channel. Reset shows
+    the first frame ``skip`` times.
+    """
+
+    def reset(self, *, seed=None, options=None):
+        self._stack, info = super().reset(seed=seed, options=options)
+        return self._stack, info
+
+    def step(self, action):
+        total, terminated, truncated = 0.0, False, False
+        self.frames, pooled = [], []
+        for i in range(self.skip):
+            frame, reward, terminated, truncated, info = self.env.step(action)
+            self._keep(frame)
+            total += reward
+            if i >= self.skip // 2:
+                pooled.append(gray_84(frame))
+            if terminated or truncated:
+                break
+        newest = np.max(pooled, axis=0) if pooled else gray_84(frame)
+        # a new array each step (never written in place), so a returned observation stays as it was
+        self._stack = np.concatenate([self._stack[:, :, 1:], newest[:, :, None]], axis=2)
+        return self._stack, total, terminated, truncated, _trim(info)
+
+
 class StallLimit(gym.Wrapper):
     """End the episode once Mario's x has not passed its best for ``steps`` agent steps.
 
@@ -192,11 +228,12 @@ def _trim(info: dict) -> dict:
 
 def make_env(render_mode: str | None = None, max_episode_steps: int | None = None, world: int = 1,
              stage: int = 1, actions: str = "simple", skip: int = 4, score_reward: float = 0.0,
-             stall_steps: int = 0, stall_outcome: str = "truncate") -> gym.Env:
+             stall_steps: int = 0, stall_outcome: str = "truncate", frames: str = "skipped") -> gym.Env:
     """The article's Mario env for one stage. ``max_episode_steps`` counts agent steps (None = none);
     ``score_reward``: reward per game-score point (0 = the article's reward); ``stall_steps``: end
     an episode after this many agent steps without a new best x (0 = never), as a truncation or as a
-    death (``stall_outcome``)."""
+    death (``stall_outcome``); ``frames``: the 4 channels hold the 4 frames of this step ("skipped") or
+    the last 4 steps ("history", see :class:`SkipAndHistory`)."""
     import gym_super_mario_bros  # noqa: F401  registers the SuperMarioBros-* ids
     from nes_py.wrappers import JoypadSpace
 
@@ -204,9 +241,12 @@ def make_env(render_mode: str | None = None, max_episode_steps: int | None = Non
 
     if not (1 <= world <= 8 and 1 <= stage <= 4):
         raise UserError(f"there is no level {world}-{stage}: world is 1-8, stage 1-4")
+    if frames not in FRAME_STACKS:
+        raise UserError(f"unknown frame stack {frames!r}; choose one of {', '.join(FRAME_STACKS)}")
     env = gym.make(f"SuperMarioBros-{world}-{stage}-v0", render_mode=render_mode).unwrapped
     env = JoypadSpace(env, action_list(actions))
-    env = SkipAndStack(ArticleShaping(ClassicReward(env, score_reward)), skip)
+    stack = SkipAndHistory if frames == "history" else SkipAndStack
+    env = stack(ArticleShaping(ClassicReward(env, score_reward)), skip)
     if stall_steps:
         env = StallLimit(env, stall_steps, stall_outcome)
     if max_episode_steps:

@@ -8,7 +8,7 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass, field
 
-from mario_ppo.env import ACTION_SETS, StallLimit, make_env
+from mario_ppo.env import ACTION_SETS, FRAME_STACKS, StallLimit, make_env
 from rlcore.allowed import OFF_OR_COUNT, Allowed, choices
 from rlcore.configs import PPOConfig
 from rlcore.experiment import AlgoSpec, Experiment
@@ -26,6 +26,10 @@ class MarioPPOConfig(PPOConfig):
     stall_steps: int = field(default=0, metadata={
         "help": "end an episode (truncated, bootstrapped) after this many agent steps without a new "
                 "best x (0 = never)", "allowed": OFF_OR_COUNT})
+    frames: str = field(default="skipped", metadata={
+        "help": "what the 4 input channels hold: skipped = the 4 frames of this step (article 001); "
+                "history = the last 4 steps, each the max of its last 2 frames (uvipen's PyTorch "
+                "original), so standing still against a wall is visible", "allowed": choices(*FRAME_STACKS)})
     stall_outcome: str = field(default="truncate", metadata={
         "help": "how a stall ends: truncate (bootstrapped from V) or death (terminated, -50 / 10, "
                 "as the clock would end it)", "allowed": choices(*StallLimit.OUTCOMES)})
@@ -63,6 +67,7 @@ EXPERIMENT = Experiment(
     solved_score=None,  # success is the flag, not a return
     algos={"ppo": AlgoSpec("ppo", "ppo", "PPO, 8 envs over Pipes", {"article": ARTICLE, "default": DEFAULT})},
     video_fps=60,
-    env_fields=("world", "stage", "actions", "score_reward", "stall_steps", "stall_outcome"), success_key="flag_get", progress_key="x_pos",
+    env_fields=("world", "stage", "actions", "score_reward", "stall_steps", "stall_outcome",
+                "frames"), success_key="flag_get", progress_key="x_pos",
     eval_episodes=10, ship_by=("world", "stage"), default_model="1-1", score_label="return (shaped, /10)",
 )

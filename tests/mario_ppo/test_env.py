@@ -3,7 +3,8 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-from mario_ppo.env import FRAME_SIZE, ClassicReward, StallLimit, classic_reward, gray_84, make_env
+from mario_ppo.env import (FRAME_SIZE, ClassicReward, SkipAndHistory, SkipAndStack, StallLimit, classic_reward,
+                           gray_84, make_env)
 from rlcore.errors import UserError
 
 RIGHT = 1  # SIMPLE_MOVEMENT[1] == ['right']
@@ -42,6 +43,37 @@ def test_step_stacks_the_four_skipped_frames_in_order(env):
     for i in range(4):
         np.testing.assert_array_equal(obs[:, :, i], frames[i])
     assert not np.array_equal(obs[:, :, 0], obs[:, :, 3])  # Mario moved between them
+
+
+def test_history_stack_keeps_one_max_pooled_frame_per_step_for_the_last_four_steps():
+    """frames="history" (uvipen's): channel 3 is the max of the gray 3rd and 4th frames of this step,
+    channels 0-2 are the previous observation's 1-3; replayed frame by frame on a second emulator."""
+    import gym_super_mario_bros  # noqa: F401
+    from gym_super_mario_bros.actions import SIMPLE_MOVEMENT
+    from nes_py.wrappers import JoypadSpace
+
+    env = make_env(frames="history")
+    raw = JoypadSpace(gym.make("SuperMarioBros-1-1-v0").unwrapped, SIMPLE_MOVEMENT)
+    try:
+        first, _ = env.reset(seed=0)
+        raw_first = gray_84(raw.reset(seed=0)[0])
+        assert first.shape == (FRAME_SIZE, FRAME_SIZE, 4) and env.observation_space.contains(first)
+        for i in range(4):
+            np.testing.assert_array_equal(first[:, :, i], raw_first)
+        previous, max_mattered = first, False
+        for step in range(12):  # run right, with jumps (A) in steps 4-7
+            action = 2 if 4 <= step < 8 else RIGHT  # SIMPLE_MOVEMENT[2] == ['right', 'A']
+            obs, *_ = env.step(action)
+            frames = [gray_84(raw.step(action)[0]) for _ in range(4)]
+            np.testing.assert_array_equal(obs[:, :, 3], np.maximum(frames[2], frames[3]))
+            np.testing.assert_array_equal(obs[:, :, :3], previous[:, :, 1:])
+            max_mattered |= not np.array_equal(obs[:, :, 3], frames[3])
+            previous = obs
+        assert not np.array_equal(previous[:, :, 0], previous[:, :, 3])  # Mario moved in 4 steps
+        assert max_mattered  # the channel is not simply the step's last frame
+    finally:
+        env.close()
+        raw.close()
 
 
 def test_running_right_pays_the_x_gain_over_ten(env):
@@ -130,11 +162,13 @@ def test_a_stall_can_end_as_a_death_with_the_end_penalty():
     assert steps[0][1] == 123.0
 
 
-def test_unknown_level_and_action_set_are_clear_errors():
+def test_unknown_level_action_set_and_frame_stack_are_clear_errors():
     with pytest.raises(UserError, match="no level 9-1"):
         make_env(world=9)
     with pytest.raises(UserError, match="unknown action set 'fancy'"):
         make_env(actions="fancy")
+    with pytest.raises(UserError, match="unknown frame stack 'pooled'"):
+        make_env(frames="pooled")
 
 
 def test_rgb_array_keeps_every_emulator_frame_for_video():
@@ -166,13 +200,16 @@ def test_reward_and_stall_options_reach_the_env_from_the_config():
 
     from mario_ppo.experiment import EXPERIMENT
 
-    cfg = dataclasses.replace(EXPERIMENT.preset("ppo", "default"), stall_steps=7, score_reward=0.025)
+    cfg = dataclasses.replace(EXPERIMENT.preset("ppo", "default"), stall_steps=7, score_reward=0.025,
+                              frames="history")
     env = EXPERIMENT.env_factory(cfg)()  # what the pool's workers and a saved model's policy build
     try:
         assert isinstance(env, StallLimit) and env.steps == 7
         assert env.get_wrapper_attr("score_reward") == 0.025
+        assert isinstance(env.env, SkipAndHistory)
     finally:
         env.close()
     plain = EXPERIMENT.env_factory(EXPERIMENT.preset("ppo", "default"))()
     assert not isinstance(plain, StallLimit) and plain.get_wrapper_attr("score_reward") == 0.0
+    assert type(plain) is SkipAndStack
     plain.close()
