@@ -6,7 +6,8 @@
 
 Measurements:
   emulator      NES frames/s of one raw SuperMarioBros-1-1-v0 env (no wrappers), random buttons
-  env_wrapped   agent steps/s (and frames/s) of one env with the article's wrappers (skip 4)
+  env_wrapped   agent steps/s (and frames/s) of one env with the article's wrappers (skip 4), for
+                each frame stack (--frames skipped | history)
   pool          agent steps/s of the env pool, processes over Pipes vs inline, with 1, 2, 4, 8 envs
   act           one batched action for 8 envs (compiled CNN forward + numpy sampling)
   update        one PPO update (10 epochs x 16 minibatches of 256 over 512 x 8), seconds
@@ -41,8 +42,9 @@ def bench_emulator(seconds: float):
 
     rate = random_env_rate(lambda: gym.make("SuperMarioBros-1-1-v0").unwrapped, seconds)
     emit(bench="emulator", env="SuperMarioBros-1-1-v0", frames_per_s=rate)
-    wrapped = random_env_rate(EXPERIMENT.env_factory(CFG), seconds)
-    emit(bench="env_wrapped", agent_steps_per_s=wrapped, frames_per_s=wrapped * 4)
+    for frames in ("skipped", "history"):  # history grays 2 of a step's 4 frames, skipped all 4
+        wrapped = random_env_rate(EXPERIMENT.env_factory(dataclasses.replace(CFG, frames=frames)), seconds)
+        emit(bench="env_wrapped", frames=frames, agent_steps_per_s=wrapped, frames_per_s=wrapped * 4)
 
 
 def bench_pool(seconds: float):

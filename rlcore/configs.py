@@ -127,6 +127,9 @@ class PPOConfig(RunBudget):
                      Allowed(low=0, high=1, low_open=True, high_open=True))
     entropy_coef: float = _h(0.05, "entropy bonus weight", NON_NEGATIVE)
     value_coef: float = _h(1.0, "value loss weight (the article adds it unweighted)", NON_NEGATIVE)
+    value_loss: str = _h("mse", "mse: the squared error (the article); huber: 0.5 e^2 within 1, |e| - 0.5 "
+                         "beyond (uvipen's PyTorch Mario), so a few large errors cannot swamp the "
+                         "policy's share of a clipped gradient", choices("mse", "huber"))
     value_target: str = _h("gae", "gae: advantage + V(s), the lambda-return; td0: r + gamma V(s')",
                            choices("gae", "td0"))
     max_grad_norm: float = _h(0.0, "clip gradients by global norm (0 = off)", NON_NEGATIVE)

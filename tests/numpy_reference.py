@@ -61,10 +61,12 @@ def actor_loss(probs, actions, advantages, entropy_coef):
 
 
 def ppo_loss(logits, values, actions, logp_old, advantages, targets, clip, value_coef, entropy_coef,
-             quirks=False):
-    """PPO's clipped surrogate + value MSE - entropy bonus, sample by sample.
+             quirks=False, value_loss="mse"):
+    """PPO's clipped surrogate + value loss - entropy bonus, sample by sample.
 
     quirks: the article's ratio p / (p_old + 1e-3) and -log(p(a) + 1e-3) in place of the entropy.
+    value_loss: "mse", the squared error; "huber", 0.5 e^2 where |e| < 1, else |e| - 0.5 (PyTorch's
+    smooth_l1_loss, as uvipen's PyTorch Mario).
     """
     n = len(actions)
     surrogate, value_sq, entropy = np.zeros(n), np.zeros(n), np.zeros(n)
@@ -75,7 +77,11 @@ def ppo_loss(logits, values, actions, logp_old, advantages, targets, clip, value
         ratio = p_a / (p_old + 1e-3) if quirks else np.exp(np.log(p_a) - logp_old[i])
         clipped = min(max(ratio, 1 - clip), 1 + clip)
         surrogate[i] = min(ratio * advantages[i], clipped * advantages[i])
-        value_sq[i] = (values[i] - targets[i]) ** 2
+        err = values[i] - targets[i]
+        if value_loss == "huber":
+            value_sq[i] = 0.5 * err ** 2 if abs(err) < 1 else abs(err) - 0.5
+        else:
+            value_sq[i] = err ** 2
         entropy[i] = -np.log(p_a + 1e-3) if quirks else -(p * np.log(p)).sum()
     policy = -surrogate.mean()
     return policy + value_coef * value_sq.mean() - entropy_coef * entropy.mean(), policy, value_sq.mean(), entropy.mean()

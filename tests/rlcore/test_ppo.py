@@ -20,15 +20,16 @@ def _batch(rng, n=32, actions=5):
             np.log(rng.uniform(0.05, 0.9, n)), rng.normal(size=n), rng.normal(size=n))
 
 
-@pytest.mark.parametrize("quirks", [False, True])
-def test_loss_matches_numpy(quirks):
+@pytest.mark.parametrize("quirks,value_loss", [(False, "mse"), (True, "mse"), (False, "huber")])
+def test_loss_matches_numpy(quirks, value_loss):
     rng = np.random.default_rng(1)
     logits, values, actions, logp_old, adv, targets = _batch(rng)
-    cfg = dataclasses.replace(CFG, article_quirks=quirks)
+    targets = targets * 2  # errors on both sides of the Huber loss's |e| = 1
+    cfg = dataclasses.replace(CFG, article_quirks=quirks, value_loss=value_loss)
     got = ppo_losses(*(tf.constant(x, tf.float32) for x in (logits, values)), tf.constant(actions, tf.int32),
                      *(tf.constant(x, tf.float32) for x in (logp_old, adv, targets)), cfg)
     want = ref.ppo_loss(logits, values, actions, logp_old, adv, targets, cfg.clip, cfg.value_coef,
-                        cfg.entropy_coef, quirks)
+                        cfg.entropy_coef, quirks, value_loss)
     np.testing.assert_allclose([float(g) for g in got[:4]], want, rtol=1e-4, atol=1e-5)
 
 
