@@ -10,6 +10,8 @@ Stack, innermost first::
     SkipAndStack(4) | SkipAndHistory(4)      one action for 4 frames; as channels, gray 84x84 frames:
                                              the step's 4 (article 001) or one per step for the
                                              last 4 steps (uvipen's), ``frames="history"``
+    DeadEnds                                 a known dead end of the level ends as a death (off by
+                                             default)
     StallLimit(n)                            truncate once x has not passed its best for n agent
                                              steps (off by default)
 
@@ -222,18 +224,54 @@ class StallLimit(gym.Wrapper):
         return obs, reward, terminated, truncated or stalled, info
 
 
+UNDERGROUND = 2  # RAM 0x074E, the area type: 0 water, 1 overworld, 2 underground, 3 castle
+# Places a Mario with these buttons can reach but never leave toward the flag, by level:
+# (what it is, test(x_pos, area type)).
+DEAD_ENDS = {
+    (1, 2): ("the ceiling route past the exit pipe (underground beyond x 2,750) into the warp zone, "
+             "whose pipes need `down`", lambda x, area: area == UNDERGROUND and x > 2750),
+}
+
+
+class DeadEnds(gym.Wrapper):
+    """End the episode as a death (terminated, -50 / 10) once Mario is in a dead end of its level
+    (:data:`DEAD_ENDS`; levels without one are unchanged).
+
+    Seen on 1-2: past the exit pipe, a Mario who runs over the ceiling reaches the warp zone, x 3,056,
+    more x than the flag route's staircase (2,930), so the x reward led the policy there (62 % of
+    100 episodes) and it stood at the wall until the stall limit. The PyTorch original ends its
+    maze levels (4-4, 7-4) the same way when Mario takes a wrong path. A dead end never reaches the
+    flag, so evaluating with this rule counts the same flags.
+    """
+
+    def __init__(self, env: gym.Env, world: int, stage: int):
+        super().__init__(env)
+        self.rule = DEAD_ENDS.get((world, stage), (None, None))[1]
+
+    def step(self, action):
+        obs, reward, terminated, truncated, info = self.env.step(action)
+        dead_end = self.rule is not None and not terminated and self.rule(
+            info["x_pos"], int(self.env.unwrapped.ram[0x074E]))
+        info["dead_end"] = bool(dead_end)
+        if dead_end:
+            return obs, reward - ArticleShaping.END_BONUS / ArticleShaping.SCALE, True, truncated, info
+        return obs, reward, terminated, truncated, info
+
+
 def _trim(info: dict) -> dict:
     return {k: info[k] for k in INFO_KEYS if k in info}
 
 
 def make_env(render_mode: str | None = None, max_episode_steps: int | None = None, world: int = 1,
              stage: int = 1, actions: str = "simple", skip: int = 4, score_reward: float = 0.0,
-             stall_steps: int = 0, stall_outcome: str = "truncate", frames: str = "skipped") -> gym.Env:
+             stall_steps: int = 0, stall_outcome: str = "truncate", frames: str = "skipped",
+             dead_ends: bool = False) -> gym.Env:
     """The article's Mario env for one stage. ``max_episode_steps`` counts agent steps (None = none);
     ``score_reward``: reward per game-score point (0 = the article's reward); ``stall_steps``: end
     an episode after this many agent steps without a new best x (0 = never), as a truncation or as a
     death (``stall_outcome``); ``frames``: the 4 channels hold the 4 frames of this step ("skipped") or
-    the last 4 steps ("history", see :class:`SkipAndHistory`)."""
+    the last 4 steps ("history", see :class:`SkipAndHistory`); ``dead_ends``: end an episode as a death
+    in a known dead end of the level (:data:`DEAD_ENDS`)."""
     import gym_super_mario_bros  # noqa: F401  registers the SuperMarioBros-* ids
     from nes_py.wrappers import JoypadSpace
 
@@ -247,6 +285,8 @@ def make_env(render_mode: str | None = None, max_episode_steps: int | None = Non
     env = JoypadSpace(env, action_list(actions))
     stack = SkipAndHistory if frames == "history" else SkipAndStack
     env = stack(ArticleShaping(ClassicReward(env, score_reward)), skip)
+    if dead_ends:
+        env = DeadEnds(env, world, stage)
     if stall_steps:
         env = StallLimit(env, stall_steps, stall_outcome)
     if max_episode_steps:

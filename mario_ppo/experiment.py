@@ -30,6 +30,9 @@ class MarioPPOConfig(PPOConfig):
         "help": "what the 4 input channels hold: skipped = the 4 frames of this step (article 001); "
                 "history = the last 4 steps, each the max of its last 2 frames (uvipen's PyTorch "
                 "original), so standing still against a wall is visible", "allowed": choices(*FRAME_STACKS)})
+    dead_ends: bool = field(default=False, metadata={
+        "help": "end an episode as a death where the level has a known dead end for these buttons "
+                "(1-2: the ceiling route into the warp zone); the flags counted do not change"})
     stall_outcome: str = field(default="truncate", metadata={
         "help": "how a stall ends: truncate (bootstrapped from V) or death (terminated, -50 / 10, "
                 "as the clock would end it)", "allowed": choices(*StallLimit.OUTCOMES)})
@@ -68,6 +71,6 @@ EXPERIMENT = Experiment(
     algos={"ppo": AlgoSpec("ppo", "ppo", "PPO, 8 envs over Pipes", {"article": ARTICLE, "default": DEFAULT})},
     video_fps=60,
     env_fields=("world", "stage", "actions", "score_reward", "stall_steps", "stall_outcome",
-                "frames"), success_key="flag_get", progress_key="x_pos",
+                "frames", "dead_ends"), success_key="flag_get", progress_key="x_pos",
     eval_episodes=10, ship_by=("world", "stage"), default_model="1-1", score_label="return (shaped, /10)",
 )

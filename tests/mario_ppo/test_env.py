@@ -3,8 +3,8 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-from mario_ppo.env import (FRAME_SIZE, ClassicReward, SkipAndHistory, SkipAndStack, StallLimit, classic_reward,
-                           gray_84, make_env)
+from mario_ppo.env import (FRAME_SIZE, ClassicReward, DeadEnds, SkipAndHistory, SkipAndStack, StallLimit,
+                           classic_reward, gray_84, make_env)
 from rlcore.errors import UserError
 
 RIGHT = 1  # SIMPLE_MOVEMENT[1] == ['right']
@@ -162,6 +162,35 @@ def test_a_stall_can_end_as_a_death_with_the_end_penalty():
     assert steps[0][1] == 123.0
 
 
+class _ScriptedPlaces(_ScriptedInfos):
+    """The stand-in with an area type in RAM 0x074E, as the emulator keeps it."""
+
+    def __init__(self, places):
+        super().__init__([(x, 400, 0, False) for x, _ in places])
+        self.areas = [area for _, area in places]
+        self.ram = np.zeros(2048, np.uint8)
+
+    def step(self, action):
+        out = super().step(action)
+        self.ram[0x074E] = self.areas[self.i]
+        return out
+
+
+def test_a_dead_end_of_the_level_ends_as_a_death():
+    # 1-2: underground past x 2,750 is the ceiling route to the warp zone; the exit pipe leads
+    # overworld (area 1), where x 2,872 and on is the way to the flag
+    places = [(2600, 2), (2740, 2), (2872, 1), (2930, 1), (2751, 2)]
+    env = DeadEnds(_ScriptedPlaces(places), world=1, stage=2)
+    env.reset()
+    steps = [env.step(0) for _ in places[1:]]
+    assert [s[2] for s in steps] == [False, False, False, True]
+    assert [s[4]["dead_end"] for s in steps] == [False, False, False, True]
+    assert steps[-1][1] == 123.0 - 5.0 and steps[0][1] == 123.0
+    other_level = DeadEnds(_ScriptedPlaces(places), world=1, stage=1)  # no rule: nothing changes
+    other_level.reset()
+    assert not any(other_level.step(0)[2] for _ in places[1:])
+
+
 def test_unknown_level_action_set_and_frame_stack_are_clear_errors():
     with pytest.raises(UserError, match="no level 9-1"):
         make_env(world=9)
@@ -201,12 +230,13 @@ def test_reward_and_stall_options_reach_the_env_from_the_config():
     from mario_ppo.experiment import EXPERIMENT
 
     cfg = dataclasses.replace(EXPERIMENT.preset("ppo", "default"), stall_steps=7, score_reward=0.025,
-                              frames="history")
+                              frames="history", dead_ends=True, stage=2)
     env = EXPERIMENT.env_factory(cfg)()  # what the pool's workers and a saved model's policy build
     try:
         assert isinstance(env, StallLimit) and env.steps == 7
         assert env.get_wrapper_attr("score_reward") == 0.025
-        assert isinstance(env.env, SkipAndHistory)
+        assert isinstance(env.env, DeadEnds) and env.env.rule is not None
+        assert isinstance(env.env.env, SkipAndHistory)
     finally:
         env.close()
     plain = EXPERIMENT.env_factory(EXPERIMENT.preset("ppo", "default"))()
