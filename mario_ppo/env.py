@@ -98,6 +98,10 @@ class ArticleShaping(gym.Wrapper):
         return obs, reward / self.SCALE, terminated, truncated, info
 
 
+# what a wrapper that ends an episode as a death (a stall, a dead end) takes off: the shaped -50 / 10
+DEATH_PENALTY = ArticleShaping.END_BONUS / ArticleShaping.SCALE
+
+
 def gray_84(frame: np.ndarray) -> np.ndarray:
     """RGB NES frame (240x256x3) -> gray uint8 84x84 (the article's cv2 gray + resize).
 
@@ -220,16 +224,17 @@ class StallLimit(gym.Wrapper):
             self._since += 1
         info["stalled"] = stalled = self._since >= self.steps and not (terminated or truncated)
         if stalled and self.as_death:
-            return obs, reward - ArticleShaping.END_BONUS / ArticleShaping.SCALE, True, truncated, info
+            return obs, reward - DEATH_PENALTY, True, truncated, info
         return obs, reward, terminated, truncated or stalled, info
 
 
 UNDERGROUND = 2  # RAM 0x074E, the area type: 0 water, 1 overworld, 2 underground, 3 castle
 # Places a Mario with these buttons can reach but never leave toward the flag, by level:
-# (what it is, test(x_pos, area type)).
+# test(x_pos, area type).
 DEAD_ENDS = {
-    (1, 2): ("the ceiling route past the exit pipe (underground beyond x 2,750) into the warp zone, "
-             "whose pipes need `down`", lambda x, area: area == UNDERGROUND and x > 2750),
+    # 1-2: the ceiling route past the exit pipe (underground beyond x 2,750) into the warp zone,
+    # whose pipes need `down`
+    (1, 2): lambda x, area: area == UNDERGROUND and x > 2750,
 }
 
 
@@ -246,7 +251,7 @@ class DeadEnds(gym.Wrapper):
 
     def __init__(self, env: gym.Env, world: int, stage: int):
         super().__init__(env)
-        self.rule = DEAD_ENDS.get((world, stage), (None, None))[1]
+        self.rule = DEAD_ENDS.get((world, stage))
 
     def step(self, action):
         obs, reward, terminated, truncated, info = self.env.step(action)
@@ -254,7 +259,7 @@ class DeadEnds(gym.Wrapper):
             info["x_pos"], int(self.env.unwrapped.ram[0x074E]))
         info["dead_end"] = bool(dead_end)
         if dead_end:
-            return obs, reward - ArticleShaping.END_BONUS / ArticleShaping.SCALE, True, truncated, info
+            return obs, reward - DEATH_PENALTY, True, truncated, info
         return obs, reward, terminated, truncated, info
 
 

@@ -61,10 +61,11 @@ def ppo_losses(logits, values, actions, logp_old, advantages, targets, cfg: PPOC
         entropy = -tf.reduce_mean(tf.reduce_sum(tf.exp(logp_all) * logp_all, axis=1))
     clipped = tf.clip_by_value(ratio, 1.0 - cfg.clip, 1.0 + cfg.clip)
     policy_loss = -tf.reduce_mean(tf.minimum(ratio * advantages, clipped * advantages))
+    err = values - targets
     if cfg.value_loss == "huber":  # = PyTorch's smooth_l1_loss with beta 1
-        value_loss = tf.reduce_mean(tf.keras.losses.huber(targets[:, None], values[:, None], delta=1.0))
+        value_loss = tf.reduce_mean(tf.where(tf.abs(err) < 1.0, 0.5 * tf.square(err), tf.abs(err) - 0.5))
     else:
-        value_loss = tf.reduce_mean(tf.square(values - targets))
+        value_loss = tf.reduce_mean(tf.square(err))
     total = policy_loss + cfg.value_coef * value_loss - cfg.entropy_coef * entropy
     approx_kl = tf.reduce_mean(logp_old - logp)
     clip_fraction = tf.reduce_mean(tf.cast(tf.abs(ratio - 1.0) > cfg.clip, tf.float32))
