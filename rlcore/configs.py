@@ -104,6 +104,9 @@ class A2CConfig(EpisodeLoop):
     reward_scale: float = _h(0.01, "rewards are multiplied by this in the TD target", POSITIVE)
     entropy_coef: float = _h(0.0, "entropy bonus weight in the actor loss", NON_NEGATIVE)
     max_grad_norm: float = _h(0.0, "clip gradients by global norm (0 = off)", NON_NEGATIVE)
+    target_kl: float = _h(0.0, "end an update early, before the first minibatch step whose approx KL "
+                               "to the acting policy passes 1.5 x this (SB3's target_kl; 0 = off)",
+                          NON_NEGATIVE)
     normalize_advantage: bool = _h(False, "standardize advantages within each update")
 
 
@@ -133,6 +136,9 @@ class PPOConfig(RunBudget):
     value_target: str = _h("gae", "gae: advantage + V(s), the lambda-return; td0: r + gamma V(s')",
                            choices("gae", "td0"))
     max_grad_norm: float = _h(0.0, "clip gradients by global norm (0 = off)", NON_NEGATIVE)
+    target_kl: float = _h(0.0, "end an update early, before the first minibatch step whose approx KL "
+                               "to the acting policy passes 1.5 x this (SB3's target_kl; 0 = off)",
+                          NON_NEGATIVE)
     normalize_advantage: bool = _h(False, "standardize advantages within each minibatch")
     article_quirks: bool = _h(False, "the article's ratio p/(p_old+1e-3) and log p(a) as entropy")
     checkpoint_rollouts: int = _h(10, "rollouts between checkpoints", COUNT)

@@ -50,10 +50,24 @@ def wandb_row(row: dict, table: str) -> dict:
     return {(k if k == STEP_KEY else f"{table}/{k}"): v for k, v in numbers.items()}
 
 
+def _widen_header(path: Path, names: list[str]) -> list[str]:
+    """The header of the CSV table at ``path``, with any of ``names`` it lacks appended (the file is
+    rewritten atomically; older rows get empty cells there)."""
+    with open(path, newline="") as f:
+        rows = list(csv.reader(f))
+    header = rows[0]
+    new = [name for name in names if name not in header]
+    if new:
+        with atomic_path(path) as tmp, open(tmp, "w", newline="") as f:
+            csv.writer(f).writerows([header + new] + [r + [""] * len(new) for r in rows[1:]])
+    return header + new
+
+
 class Tracker:
     """Logs one row of numbers at a time to wandb and ``<run_dir>/metrics.csv``.
 
-    The CSV columns are fixed by the first row; resuming appends to the same file.
+    The CSV columns come from the first row; resuming appends to the same file, and a column that a
+    newer version of the code logs is added to the header (older rows leave it empty).
     """
 
     def __init__(self, run_dir: str | Path, run_name: str, config: dict, wandb_mode: str = "auto",
@@ -127,11 +141,7 @@ class Tracker:
         if table not in self._tables:
             path = self.table_path(table)
             exists = path.exists() and path.stat().st_size > 0
-            if exists:
-                with open(path, newline="") as f:
-                    fieldnames = next(csv.reader(f))
-            else:
-                fieldnames = list(row)
+            fieldnames = _widen_header(path, list(row)) if exists else list(row)
             handle = open(path, "a", newline="")
             writer = csv.DictWriter(handle, fieldnames=fieldnames, extrasaction="ignore")
             if not exists:

@@ -87,6 +87,12 @@ def ppo_loss(logits, values, actions, logp_old, advantages, targets, clip, value
     return policy + value_coef * value_sq.mean() - entropy_coef * entropy.mean(), policy, value_sq.mean(), entropy.mean()
 
 
+def approx_kl(logp_new, logp_old):
+    """KL(pi_old || pi) estimated from the taken actions: mean of (r - 1) - log r, r = pi / pi_old."""
+    log_ratio = np.asarray(logp_new, np.float64) - np.asarray(logp_old, np.float64)
+    return float(np.mean(np.exp(log_ratio) - 1.0 - log_ratio))
+
+
 def mlp(weights, x, final_relu=False):
     """Dense layers from (kernel, bias) pairs: ReLU between them, linear at the end."""
     for i in range(0, len(weights), 2):

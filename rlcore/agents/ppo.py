@@ -12,6 +12,11 @@ Loss per minibatch::
     policy = -mean(min(ratio A, clip(ratio, 1 - eps, 1 + eps) A))
     value  = mean((V(s) - target)^2)
     loss   = policy + value_coef * value - entropy_coef * mean(H(pi(.|s)))
+    approx_kl = mean((ratio - 1) - log ratio)      (KL(pi_old || pi), never negative)
+
+With ``target_kl`` set, the update stops (before its gradient step) at the first minibatch whose
+approx_kl passes 1.5 x target_kl, as Stable-Baselines3 does; ``update_fraction`` logs the share
+of the planned minibatch steps that were taken.
 
 ``article_quirks`` swaps in the article's ratio pi / (pi_old + 1e-3) and its entropy stand-in,
 -log(pi(a|s) + 1e-3) of the taken action.
@@ -67,7 +72,8 @@ def ppo_losses(logits, values, actions, logp_old, advantages, targets, cfg: PPOC
     else:
         value_loss = tf.reduce_mean(tf.square(err))
     total = policy_loss + cfg.value_coef * value_loss - cfg.entropy_coef * entropy
-    approx_kl = tf.reduce_mean(logp_old - logp)
+    log_ratio = logp - logp_old
+    approx_kl = tf.reduce_mean(tf.exp(log_ratio) - 1.0 - log_ratio)
     clip_fraction = tf.reduce_mean(tf.cast(tf.abs(ratio - 1.0) > cfg.clip, tf.float32))
     return total, policy_loss, value_loss, entropy, approx_kl, clip_fraction
 
@@ -83,6 +89,7 @@ def rollout_targets(rewards, values, next_values, terminated, dones, cfg: PPOCon
 
 
 LOSS_NAMES = ("loss", "policy_loss", "value_loss", "entropy", "approx_kl", "clip_fraction")
+UPDATE_NAMES = LOSS_NAMES + ("update_fraction",)  # what one update reports
 
 
 class PPOAgent:
@@ -133,8 +140,10 @@ class PPOAgent:
         flat = (tf.reshape(obs, [size, *self.obs_shape]), tf.reshape(actions, [size]),
                 tf.reshape(logp_old, [size]), tf.reshape(advantages, [size]), tf.reshape(targets, [size]))
         per_epoch = size // cfg.minibatch
-        sums = tf.zeros([len(LOSS_NAMES)])
-        for step in tf.range(cfg.epochs * per_epoch):
+        planned = cfg.epochs * per_epoch
+        kl_limit = 1.5 * cfg.target_kl if cfg.target_kl > 0 else float("inf")
+        sums, taken = tf.zeros([len(LOSS_NAMES)]), tf.constant(0)
+        for step in tf.range(planned):
             epoch, k = step // per_epoch, step % per_epoch
             idx = perms[epoch, k * cfg.minibatch:(k + 1) * cfg.minibatch]
             mb_obs, mb_act, mb_logp, mb_adv, mb_tgt = (tf.gather(x, idx) for x in flat)
@@ -142,20 +151,25 @@ class PPOAgent:
                 logits, v = self.model(mb_obs, training=True)
                 losses = ppo_losses(logits, v[:, 0], mb_act, mb_logp, mb_adv, mb_tgt, cfg)
                 total = tf.debugging.check_numerics(losses[0], "PPO loss")
+            if losses[4] > kl_limit:  # the policy moved too far from the one that acted: stop here
+                break
             grads = tape.gradient(total, self.model.trainable_variables)
             if cfg.max_grad_norm > 0:
                 grads, _ = tf.clip_by_global_norm(grads, cfg.max_grad_norm)
             self.opt.apply_gradients(zip(grads, self.model.trainable_variables))
             sums += tf.stack(losses)
-        return sums / tf.cast(cfg.epochs * per_epoch, tf.float32)
+            taken += 1
+        means = sums / tf.cast(tf.maximum(taken, 1), tf.float32)
+        return tf.concat([means, [tf.cast(taken, tf.float32) / planned]], axis=0)
 
     def update(self, obs, actions, logp_old, values, next_values, rewards, terminated, dones,
                rng: np.random.Generator) -> dict[str, float]:
-        """One PPO update on a [n_steps, num_envs] rollout; returns the mean minibatch losses."""
+        """One PPO update on a [n_steps, num_envs] rollout; returns the mean losses of the minibatch
+        steps taken and ``update_fraction``, the share of the planned steps taken."""
         size = self.cfg.n_steps * self.cfg.num_envs
         perms = np.stack([rng.permutation(size) for _ in range(self.cfg.epochs)]).astype(np.int32)
         means = self._update(obs, actions, logp_old, values, next_values, rewards, terminated, dones, perms)
-        return dict(zip(LOSS_NAMES, (float(x) for x in means.numpy())))
+        return dict(zip(UPDATE_NAMES, (float(x) for x in means.numpy())))
 
     # ------------------------------------------------------------ persistence
     def save(self, folder: str | Path) -> list[Path]:

@@ -14,7 +14,7 @@ import numpy as np
 import tensorflow as tf
 from tqdm import tqdm
 
-from rlcore.agents.ppo import LOSS_NAMES, MODEL_FILE, PPOAgent
+from rlcore.agents.ppo import MODEL_FILE, UPDATE_NAMES, PPOAgent
 from rlcore.errors import UserError
 from rlcore.trainers import checkpoints
 from rlcore.trainers.session import TrainingSession
@@ -78,7 +78,7 @@ def train(spec: RunSpec) -> Path:
     t, n = cfg.n_steps, cfg.num_envs
     buf = Rollout(t, n, obs_shape)
     running = np.zeros(n)
-    losses = {name: float("nan") for name in LOSS_NAMES}  # CSV columns exist from the first row
+    losses = {name: float("nan") for name in UPDATE_NAMES}  # CSV columns exist from the first row
     # a resumed run starts fresh episodes, reseeded from its episode count
     obs, _ = envs.reset(seed=session.fresh_env_seeds(n))
     with envs, session.interruptible():

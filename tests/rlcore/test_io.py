@@ -113,6 +113,17 @@ def test_tracker_writes_csv_and_an_offline_wandb_run(tmp_path):
     assert (run_dirs[0] / f"run-{run_id}.wandb").stat().st_size > 0
 
 
+def test_a_resumed_tracker_adds_a_new_column_to_the_header(tmp_path):
+    tracker = Tracker(tmp_path, "test-run", {}, wandb_mode="off")
+    tracker.log({"env_steps": 1, "loss": 0.5}, table="rollouts")
+    tracker.close()
+    resumed = Tracker(tmp_path, "test-run", {}, wandb_mode="off")
+    resumed.log({"env_steps": 2, "loss": 0.25, "update_fraction": 1.0}, table="rollouts")
+    resumed.close()
+    lines = (tmp_path / "rollouts.csv").read_text().splitlines()
+    assert lines == ["env_steps,loss,update_fraction", "1,0.5,", "2,0.25,1.0"]
+
+
 def test_record_video_writes_a_decodable_mp4(tmp_path):
     out = tmp_path / "toy.mp4"
     result = record_video(toy.EXPERIMENT, lambda obs: np.ones(len(obs), np.int64), out, fps=30, episodes=2,

@@ -31,6 +31,8 @@ def test_loss_matches_numpy(quirks, value_loss):
     want = ref.ppo_loss(logits, values, actions, logp_old, adv, targets, cfg.clip, cfg.value_coef,
                         cfg.entropy_coef, quirks, value_loss)
     np.testing.assert_allclose([float(g) for g in got[:4]], want, rtol=1e-4, atol=1e-5)
+    logp_new = tf.gather(tf.nn.log_softmax(logits), actions, batch_dims=1).numpy()
+    assert float(got[4]) == pytest.approx(ref.approx_kl(logp_new, logp_old), rel=1e-4)
 
 
 def test_ratio_is_clipped_only_where_it_helps():
@@ -70,34 +72,47 @@ def _rollout(rng, cfg=CFG):
             (rng.random((t, n)) < 0.1).astype(np.float32), (rng.random((t, n)) < 0.15).astype(np.float32))
 
 
-def test_compiled_update_equals_an_eager_minibatch_loop():
-    """The one-call update does exactly: targets once, then epochs x shuffled minibatches of Adam."""
-    keras_seed = 3
-    tf.keras.utils.set_random_seed(keras_seed)
-    agent = PPOAgent(OBS, 5, CFG)
-    twin = PPOAgent(OBS, 5, CFG)
+@pytest.mark.parametrize("target_kl", [0.0, 0.0005])
+def test_compiled_update_equals_an_eager_minibatch_loop(target_kl):
+    """The one-call update does exactly: targets once, then epochs x shuffled minibatches of Adam,
+    stopping (with target_kl) before the first step whose minibatch KL passes 1.5 x target_kl."""
+    cfg = dataclasses.replace(CFG, target_kl=target_kl)
+    tf.keras.utils.set_random_seed(3)
+    agent = PPOAgent(OBS, 5, cfg)
+    twin = PPOAgent(OBS, 5, cfg)
     twin.model.set_weights(agent.model.get_weights())
-    rollout = _rollout(np.random.default_rng(4))
-    agent.update(*rollout, np.random.default_rng(5))
+    rollout = list(_rollout(np.random.default_rng(4)))
+    probs, _ = agent.policy_and_values(rollout[0].reshape(-1, *OBS))  # logp of the acting policy
+    rollout[2] = np.log(probs[np.arange(len(probs)), rollout[1].ravel()]).reshape(rollout[1].shape).astype(np.float32)
+    report = agent.update(*rollout, np.random.default_rng(5))
 
     obs, actions, logp, values, next_values, rewards, terminated, dones = rollout
-    adv, tgt = rollout_targets(*(tf.constant(x) for x in (rewards, values, next_values, terminated, dones)), CFG)
-    size = CFG.n_steps * CFG.num_envs
+    adv, tgt = rollout_targets(*(tf.constant(x) for x in (rewards, values, next_values, terminated, dones)), cfg)
+    size = cfg.n_steps * cfg.num_envs
     flat = [x.reshape(size, *x.shape[2:]) for x in (obs, actions, logp, adv.numpy(), tgt.numpy())]
     rng = np.random.default_rng(5)
-    perms = [rng.permutation(size) for _ in range(CFG.epochs)]
-    for perm in perms:
-        for k in range(size // CFG.minibatch):
-            idx = perm[k * CFG.minibatch:(k + 1) * CFG.minibatch]
-            o, a, lp, ad, tg = (x[idx] for x in flat)
-            with tf.GradientTape() as tape:
-                logits, v = twin.model(o, training=True)
-                loss = ppo_losses(logits, v[:, 0], a, lp, ad, tg, CFG)[0]
-            grads = tape.gradient(loss, twin.model.trainable_variables)
-            twin.opt.apply_gradients(zip(grads, twin.model.trainable_variables))
+    perms = [rng.permutation(size) for _ in range(cfg.epochs)]
+    steps = [perm[k * cfg.minibatch:(k + 1) * cfg.minibatch] for perm in perms for k in range(size // cfg.minibatch)]
+    taken = 0
+    for idx in steps:
+        o, a, lp, ad, tg = (x[idx] for x in flat)
+        with tf.GradientTape() as tape:
+            logits, v = twin.model(o, training=True)
+            loss = ppo_losses(logits, v[:, 0], a, lp, ad, tg, cfg)[0]
+        logp_new = tf.gather(tf.nn.log_softmax(logits), a, batch_dims=1).numpy()
+        if target_kl and ref.approx_kl(logp_new, lp) > 1.5 * target_kl:
+            break
+        grads = tape.gradient(loss, twin.model.trainable_variables)
+        twin.opt.apply_gradients(zip(grads, twin.model.trainable_variables))
+        taken += 1
     for got, want in zip(agent.model.get_weights(), twin.model.get_weights()):
         np.testing.assert_allclose(got, want, rtol=1e-4, atol=1e-6)
-    assert int(agent.opt.iterations) == CFG.epochs * size // CFG.minibatch
+    assert int(agent.opt.iterations) == taken
+    assert report["update_fraction"] == pytest.approx(taken / len(steps))
+    if target_kl:  # the guard stopped this update part-way
+        assert 0 < taken < len(steps)
+    else:
+        assert taken == len(steps)
 
 
 def test_update_raises_the_probability_of_advantaged_actions():
