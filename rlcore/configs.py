@@ -104,9 +104,6 @@ class A2CConfig(EpisodeLoop):
     reward_scale: float = _h(0.01, "rewards are multiplied by this in the TD target", POSITIVE)
     entropy_coef: float = _h(0.0, "entropy bonus weight in the actor loss", NON_NEGATIVE)
     max_grad_norm: float = _h(0.0, "clip gradients by global norm (0 = off)", NON_NEGATIVE)
-    target_kl: float = _h(0.0, "end an update early, before the first minibatch step whose approx KL "
-                               "to the acting policy passes 1.5 x this (SB3's target_kl; 0 = off)",
-                          NON_NEGATIVE)
     normalize_advantage: bool = _h(False, "standardize advantages within each update")
 
 

@@ -62,6 +62,9 @@ BAD_VALUES = [
     (["train", "mario_ppo", "ppo", "--eval-every-steps", "1000"], "unrecognized arguments: --eval-every-steps"),
     (["train", "mario_ppo", "ppo", "--stop-eval-score", "1"], "unrecognized arguments: --stop-eval-score"),
     (["train", "mario_ppo", "ppo", "--checkpoint-every", "5"], "unrecognized arguments: --checkpoint-every"),
+    (["train", "mario_ppo", "ppo", "--target-kl", "-0.1"], "--target-kl -0.1 is invalid"),
+    # nor does A2C: its update has no minibatches for a KL guard to stop
+    (["train", "cartpole", "a2c", "--target-kl", "0.1"], "unrecognized arguments: --target-kl"),
 ]
 
 
