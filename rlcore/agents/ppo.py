@@ -89,6 +89,7 @@ def rollout_targets(rewards, values, next_values, terminated, dones, cfg: PPOCon
 
 
 LOSS_NAMES = ("loss", "policy_loss", "value_loss", "entropy", "approx_kl", "clip_fraction")
+APPROX_KL = LOSS_NAMES.index("approx_kl")
 UPDATE_NAMES = LOSS_NAMES + ("update_fraction",)  # what one update reports
 
 
@@ -142,7 +143,7 @@ class PPOAgent:
         per_epoch = size // cfg.minibatch
         planned = cfg.epochs * per_epoch
         kl_limit = 1.5 * cfg.target_kl if cfg.target_kl > 0 else float("inf")
-        sums, taken = tf.zeros([len(LOSS_NAMES)]), tf.constant(0)
+        sums, evaluated, taken = tf.zeros([len(LOSS_NAMES)]), tf.constant(0), tf.constant(0)
         for step in tf.range(planned):
             epoch, k = step // per_epoch, step % per_epoch
             idx = perms[epoch, k * cfg.minibatch:(k + 1) * cfg.minibatch]
@@ -151,21 +152,23 @@ class PPOAgent:
                 logits, v = self.model(mb_obs, training=True)
                 losses = ppo_losses(logits, v[:, 0], mb_act, mb_logp, mb_adv, mb_tgt, cfg)
                 total = tf.debugging.check_numerics(losses[0], "PPO loss")
-            if losses[4] > kl_limit:  # the policy moved too far from the one that acted: stop here
+            sums += tf.stack(losses)
+            evaluated += 1
+            if losses[APPROX_KL] > kl_limit:  # the policy moved too far from the one that acted: stop here
                 break
             grads = tape.gradient(total, self.model.trainable_variables)
             if cfg.max_grad_norm > 0:
                 grads, _ = tf.clip_by_global_norm(grads, cfg.max_grad_norm)
             self.opt.apply_gradients(zip(grads, self.model.trainable_variables))
-            sums += tf.stack(losses)
             taken += 1
-        means = sums / tf.cast(tf.maximum(taken, 1), tf.float32)
+        means = sums / tf.cast(evaluated, tf.float32)  # the minibatch that stopped the update counts
         return tf.concat([means, [tf.cast(taken, tf.float32) / planned]], axis=0)
 
     def update(self, obs, actions, logp_old, values, next_values, rewards, terminated, dones,
                rng: np.random.Generator) -> dict[str, float]:
-        """One PPO update on a [n_steps, num_envs] rollout; returns the mean losses of the minibatch
-        steps taken and ``update_fraction``, the share of the planned steps taken."""
+        """One PPO update on a [n_steps, num_envs] rollout; returns the mean losses of the minibatches
+        evaluated (those stepped on, and the one that stopped the update, as in Stable-Baselines3) and
+        ``update_fraction``, the share of the planned steps taken."""
         size = self.cfg.n_steps * self.cfg.num_envs
         perms = np.stack([rng.permutation(size) for _ in range(self.cfg.epochs)]).astype(np.int32)
         means = self._update(obs, actions, logp_old, values, next_values, rewards, terminated, dones, perms)

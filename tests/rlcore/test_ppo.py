@@ -93,14 +93,15 @@ def test_compiled_update_equals_an_eager_minibatch_loop(target_kl):
     rng = np.random.default_rng(5)
     perms = [rng.permutation(size) for _ in range(cfg.epochs)]
     steps = [perm[k * cfg.minibatch:(k + 1) * cfg.minibatch] for perm in perms for k in range(size // cfg.minibatch)]
-    taken = 0
+    taken, kls = 0, []
     for idx in steps:
         o, a, lp, ad, tg = (x[idx] for x in flat)
         with tf.GradientTape() as tape:
             logits, v = twin.model(o, training=True)
             loss = ppo_losses(logits, v[:, 0], a, lp, ad, tg, cfg)[0]
         logp_new = tf.gather(tf.nn.log_softmax(logits), a, batch_dims=1).numpy()
-        if target_kl and ref.approx_kl(logp_new, lp) > 1.5 * target_kl:
+        kls.append(ref.approx_kl(logp_new, lp))
+        if target_kl and kls[-1] > 1.5 * target_kl:
             break
         grads = tape.gradient(loss, twin.model.trainable_variables)
         twin.opt.apply_gradients(zip(grads, twin.model.trainable_variables))
@@ -109,6 +110,7 @@ def test_compiled_update_equals_an_eager_minibatch_loop(target_kl):
         np.testing.assert_allclose(got, want, rtol=1e-4, atol=1e-6)
     assert int(agent.opt.iterations) == taken
     assert report["update_fraction"] == pytest.approx(taken / len(steps))
+    assert report["approx_kl"] == pytest.approx(np.mean(kls), rel=1e-3)  # the stopping minibatch's KL counts
     if target_kl:  # the guard stopped this update part-way
         assert 0 < taken < len(steps)
     else:
