@@ -320,7 +320,7 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
     sweep.add_argument("--address", default=None,
                        help="join a running Ray cluster (e.g. 10.0.0.5:6379) instead of starting local Ray")
     sweep.add_argument("--resume", action="store_true", help="continue the sweep NAME; finished trials are kept")
-    report = sub.add_parser("report", help="results of sweeps: per run, and mean / median / IQM with 95% CIs",
+    report = sub.add_parser("report", help="results of sweeps: per run, and mean / median / IQM with 95%% CIs",
                             description="Per run: the final evaluation on unseen seeds, env steps, wall time. "
                                         "Over runs: mean, median and IQM with 95%% stratified bootstrap CIs "
                                         "(rliable's method); with two sweeps, P(first beats second). Writes "

@@ -136,6 +136,15 @@ def test_list_and_help(capsys):
     assert code == 0 and "--tau FLOAT" in out and "--updates-per-call" in out
 
 
+@pytest.mark.parametrize("argv", [[], *([name] for name in main.COMMANDS)])
+def test_every_help_page_prints(capsys, argv):
+    """`main.py --help` and each command's --help: exit 0 and a usage line, never a traceback."""
+    code, out, _ = run(capsys, *argv, "--help")
+    assert code == 0 and out.startswith("usage: main.py")
+    if not argv:  # the top page names every command
+        assert all(name in out for name in main.COMMANDS)
+
+
 def test_plot_of_an_unfinished_mario_run(capsys, tmp_path):
     """A run with only a checkpoint and its metrics (training still going) gets its plots."""
     from rlcore.checkpoint import save_checkpoint
