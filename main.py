@@ -23,6 +23,7 @@ from rlcore import allowed  # noqa: E402
 from rlcore.allowed import Allowed, whole_number  # noqa: E402
 from rlcore.seeding import MAX_RUN_SEED  # noqa: E402
 from rlcore.errors import UserError  # noqa: E402
+from rlcore.atomic import writable_folder  # noqa: E402  (TF-free)
 
 # ---------------------------------------------------------------- commands
 def cmd_list(args) -> int:
@@ -148,6 +149,11 @@ def cmd_render(args) -> int:
     load_policy(model_dir, args.experiment, args.algo)  # checks before any file is written
     name = f"{args.experiment}_{args.algo}" + (f"_{model_dir.name}" if args.world or args.stage else "")
     out = Path(args.out) if args.out else Path("videos") / f"{name}.mp4"
+    if out.is_dir():
+        out = out / f"{name}.mp4"
+    if out.suffix.lower() != ".mp4":
+        raise UserError(f"--out {out}: give a file name ending in .mp4, or a folder")
+    writable_folder(out.parent, "--out")
     _render(model_dir, out, args.fps, args.episodes, args.seed)
     return 0
 
@@ -168,7 +174,7 @@ def cmd_plot(args) -> int:
     else:
         raise UserError(f"{run_dir} has neither a checkpoint nor a model/meta.json to say what it trained")
     out_dir = Path(args.out) if args.out else run_dir / "plots"
-    out_dir.mkdir(parents=True, exist_ok=True)
+    writable_folder(out_dir, "--out")
     for path in plot_run(run_dir, out_dir, get_experiment(about["experiment"]), about):
         print(f"plot:    {path}")
     return 0
@@ -288,7 +294,7 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
             p.add_argument("--record", action="store_true",
                            help="write the result into the model folder's meta.json as its evaluation")
         else:
-            p.add_argument("--out", default=None, help="MP4 path (default videos/EXPERIMENT_ALGO.mp4)")
+            p.add_argument("--out", default=None, help="MP4 path, or a folder for it (default videos/EXPERIMENT_ALGO.mp4)")
             p.add_argument("--fps", type=whole_number(Allowed(low=1, high=240)), default=None,
                            help="frames per second (default: experiment's)")
             p.add_argument("--episodes", type=COUNT, default=None, help="default 1; Minitaur 3")

@@ -11,6 +11,21 @@ import tempfile
 from pathlib import Path
 from typing import Callable, Iterator
 
+from rlcore.errors import UserError
+
+
+def writable_folder(folder: str | os.PathLike, what: str) -> Path:
+    """Create ``folder`` (with its parents) and check that a file can be written in it, before any
+    work whose result would go there; otherwise one clear error naming ``what`` (e.g. ``--out``)."""
+    folder = Path(folder)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=folder):
+            pass
+    except OSError as exc:
+        raise UserError(f"{what} {folder}: cannot write there ({exc.strerror or exc})") from None
+    return folder
+
 
 @contextlib.contextmanager
 def atomic_path(target: str | os.PathLike) -> Iterator[Path]:

@@ -26,7 +26,7 @@ import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
-from rlcore.atomic import write_json
+from rlcore.atomic import writable_folder, write_json
 from rlcore.errors import UserError
 
 SWEEPS_DIR = Path("sweeps")
@@ -222,8 +222,7 @@ def run_sweep(sweep: Sweep, address: str | None = None, num_cpus: int | None = N
     from rlcore import experiment as registry
 
     check(sweep)
-    folder = Path(sweep.folder)
-    folder.mkdir(parents=True, exist_ok=True)
+    folder = writable_folder(sweep.folder, "sweep folder")
     sweep.save()
     (folder / STOP_FILE).unlink(missing_ok=True)
     os.environ["TUNE_DISABLE_SIGINT_HANDLER"] = "1"  # our handler: stop trials at a checkpoint

@@ -80,6 +80,35 @@ def test_a_bad_value_is_one_line_exit_2_and_no_run_folder(capsys, tmp_path, argv
     assert not run_dir.exists()
 
 
+UNWRITABLE = [  # BLOCK is a file, so nothing can be written "inside" it (as root too)
+    (["train", "cartpole", "dqn", "--episodes", "1", "--wandb", "off", "--run-dir", "BLOCK/run"], "run folder"),
+    (["render", "lunar_lander", "dqn", "--out", "BLOCK/demo.mp4"], "--out"),
+    (["plot", "RUN", "--out", "BLOCK/plots"], "--out"),
+]
+
+
+@pytest.mark.parametrize("argv, what", UNWRITABLE)
+def test_an_unwritable_output_place_is_one_line_exit_2(capsys, tmp_path, argv, what):
+    block = tmp_path / "block"
+    block.write_text("a file, not a folder")
+    run_dir = tmp_path / "run"
+    (run_dir).mkdir()
+    (run_dir / "metrics.csv").write_text("episode,total_points\n1,2.0\n")
+    (run_dir / "model").mkdir()
+    (run_dir / "model" / "meta.json").write_text('{"experiment": "toy", "algo": "dqn"}')
+    argv = [a.replace("BLOCK", str(block)).replace("RUN", str(run_dir)) for a in argv]
+    code, out, err = run(capsys, *argv)
+    assert code == 2, (out, err)
+    assert f"{what} {block}" in err and "cannot write there" in err, err
+    assert len(err.strip().splitlines()) == 1 and block.read_text() == "a file, not a folder"
+
+
+def test_render_wants_an_mp4_name_or_a_folder(capsys, tmp_path):
+    code, _, err = run(capsys, "render", "lunar_lander", "dqn", "--out", str(tmp_path / "demo.gif"))
+    assert code == 2 and "give a file name ending in .mp4, or a folder" in err
+    assert list(tmp_path.iterdir()) == []
+
+
 def _configs():
     for name in experiment_names():
         exp = get_experiment(name)

@@ -28,6 +28,7 @@ import sys
 import time
 from pathlib import Path
 
+from rlcore.atomic import writable_folder
 from rlcore.seeding import training_env_seed
 from rlcore.tracking import Tracker
 from rlcore.trainers.episodes import EpisodeBook
@@ -44,7 +45,7 @@ class TrainingSession:
         self.spec = spec
         cfg = spec.config
         self.run_dir = spec.run_dir
-        self.run_dir.mkdir(parents=True, exist_ok=True)
+        writable_folder(self.run_dir, "run folder")
         state = resumed_state or {}
         self.book = EpisodeBook(cfg.window, spec.experiment.solved_score, state.get("returns"),
                                 state.get("successes"))
