@@ -10,6 +10,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 import pandas as pd  # noqa: E402
 
 from rlcore.atomic import atomic_path  # noqa: E402
+from rlcore.errors import UserError  # noqa: E402
+
+ABOUT_KEYS = ("experiment", "algo", "preset", "seed", "config")  # what a plot's title and window need
 
 
 def plot_run(run_dir: str | Path, out_dir: str | Path, experiment, about: dict) -> list[Path]:
@@ -19,6 +22,10 @@ def plot_run(run_dir: str | Path, out_dir: str | Path, experiment, about: dict) 
     state or a ``meta.json`` does. Reads ``metrics.csv`` (one row per episode) and, when present,
     ``evals.csv``; experiments with a goal (``progress_key``) also get the progress plot.
     """
+    missing = [key for key in ABOUT_KEYS if key not in about]
+    if missing:
+        raise UserError(f"{run_dir}: its checkpoint or meta.json lacks {', '.join(missing)}; "
+                        "not a run of this package")
     run_dir, out_dir, algo = Path(run_dir), Path(out_dir), about["algo"]
     title = f"{experiment.name} {algo} ({about['preset']} preset, seed {about['seed']})"
     window = about["config"].get("window", 100)
@@ -39,7 +46,7 @@ def plot_run(run_dir: str | Path, out_dir: str | Path, experiment, about: dict) 
 def plot_episode_scores(csv_path: str | Path, png_path: str | Path, title: str,
                         solved_score: float | None = None, score_label: str = "return") -> Path:
     """Score per episode, its moving average and the solved line, as in article 000's figure."""
-    df = pd.read_csv(csv_path)
+    df = _table(csv_path, "episode", "total_points", "av_latest_points")
     fig, ax = plt.subplots(figsize=(9, 5))
     ax.plot(df["episode"], df["total_points"], color="tab:blue", linewidth=1, alpha=0.6, label="Score")
     ax.plot(df["episode"], df["av_latest_points"], color="tab:orange", linewidth=2, linestyle="--",
@@ -54,7 +61,7 @@ def plot_episode_scores(csv_path: str | Path, png_path: str | Path, title: str,
 def plot_evaluations(csv_path: str | Path, png_path: str | Path, title: str,
                      solved_score: float | None = None, score_label: str = "return") -> Path:
     """Periodic greedy evaluation: mean +- std against env steps (article 002's test-reward curve)."""
-    df = pd.read_csv(csv_path)
+    df = _table(csv_path, "env_steps", "eval_mean", "eval_std")
     fig, ax = plt.subplots(figsize=(9, 5))
     ax.plot(df["env_steps"], df["eval_mean"], color="tab:blue", linewidth=2, label="Evaluation mean")
     ax.fill_between(df["env_steps"], df["eval_mean"] - df["eval_std"], df["eval_mean"] + df["eval_std"],
@@ -70,7 +77,7 @@ def plot_progress(csv_path: str | Path, png_path: str | Path, title: str, progre
                   window: int = 100) -> Path:
     """Episodes with a goal (Mario's flag): how far each got (``progress_key``, with its moving
     average) and, on the right axis, the share of the last ``window`` episodes that succeeded."""
-    df = pd.read_csv(csv_path)
+    df = _table(csv_path, "episode", progress_key)
     fig, ax = plt.subplots(figsize=(9, 5))
     ax.plot(df["episode"], df[progress_key], color="tab:blue", linewidth=1, alpha=0.5, label=progress_key)
     ax.plot(df["episode"], df[progress_key].rolling(window, min_periods=1).mean(), color="tab:orange",
@@ -85,6 +92,18 @@ def plot_progress(csv_path: str | Path, png_path: str | Path, title: str, progre
         share.set_ylabel("success share, %")
         share.legend(loc="upper left")
     return _save(fig, ax, title, png_path)
+
+
+def _table(csv_path: str | Path, *columns: str) -> pd.DataFrame:
+    """The CSV table at ``csv_path``, checked to hold ``columns``; a damaged one is a clear error."""
+    try:
+        df = pd.read_csv(csv_path)
+    except (pd.errors.EmptyDataError, pd.errors.ParserError, UnicodeDecodeError) as exc:
+        raise UserError(f"{csv_path} is damaged or not one of ours ({type(exc).__name__})") from None
+    missing = [c for c in columns if c not in df.columns]
+    if missing:
+        raise UserError(f"{csv_path} is damaged or not one of ours (no column {', '.join(missing)})")
+    return df
 
 
 def _save(fig, ax, title, png_path) -> Path:

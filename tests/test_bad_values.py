@@ -109,6 +109,24 @@ def test_render_wants_an_mp4_name_or_a_folder(capsys, tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
+META = '{"experiment": "cartpole", "algo": "dqn", "preset": "default", "seed": 0, "config": {}}'
+DAMAGED_RUNS = [  # (metrics.csv, model/meta.json, what the one line says)
+    ("episode,total_points\n1,2.0\n", '{"experiment": "cartpole", "algo": "dqn"}', "lacks preset, seed, config"),
+    ("a,b\n1,2\n", META, "metrics.csv is damaged or not one of ours (no column episode"),
+    ("", META, "metrics.csv is damaged or not one of ours (EmptyDataError)"),
+]
+
+
+@pytest.mark.parametrize("metrics, meta, message", DAMAGED_RUNS)
+def test_plot_of_a_damaged_run_is_one_line_exit_2(capsys, tmp_path, metrics, meta, message):
+    (tmp_path / "metrics.csv").write_text(metrics)
+    (tmp_path / "model").mkdir()
+    (tmp_path / "model" / "meta.json").write_text(meta)
+    code, out, err = run(capsys, "plot", str(tmp_path))
+    assert code == 2 and message in err and len(err.strip().splitlines()) == 1, err
+    assert not (tmp_path / "plots").exists() or not list((tmp_path / "plots").iterdir())
+
+
 def _configs():
     for name in experiment_names():
         exp = get_experiment(name)
