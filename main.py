@@ -250,7 +250,7 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
 
     sub.add_parser("list", help="experiments, algorithms, presets and shipped models with their scores")
 
-    train = sub.add_parser("train", help="train an agent (Ctrl-C saves a checkpoint; --resume continues)",
+    train = sub.add_parser("train", help="train an agent (Ctrl-C or SIGTERM saves a checkpoint; --resume continues)",
                            description="Train an agent. Every hyperparameter of the chosen preset can be "
                                        "overridden; `main.py train EXPERIMENT ALGO --help` lists them.")
     train.add_argument("experiment", help="e.g. lunar_lander")
@@ -304,8 +304,8 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
         "sweep", help="many runs (seeds x grid values) on Ray Tune, locally or on a cluster",
         description="One trial per combination of --seeds and --grid values; each trial is an ordinary "
                     "run folder under sweeps/NAME/ (evaluate, render and plot work on it). A trial "
-                    "restarted after a crash resumes from its checkpoint; Ctrl-C stops every trial at a "
-                    "checkpoint; --resume continues and skips finished trials.")
+                    "restarted after a crash resumes from its checkpoint; Ctrl-C or SIGTERM stops every trial "
+                    "at a checkpoint; --resume continues and skips finished trials.")
     sweep.add_argument("experiment")
     sweep.add_argument("algo")
     sweep.add_argument("--seeds", default="0-4", help="a range or a list: 0-4, 0,3,7 (default 0-4)")

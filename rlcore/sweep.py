@@ -8,8 +8,9 @@ A trial calls :func:`rlcore.run.run_training`, the function ``main.py train`` ca
 every logged row to Tune as it comes. Fault tolerance lives in the run folder, not in Tune: a trial
 that starts where a checkpoint exists resumes it (so a trial whose worker was killed and that Tune
 restarts continues its counters), and a trial whose ``model/meta.json`` exists is finished and is
-not run again (``--resume``). Ctrl-C writes ``sweeps/<name>/STOP``: every running trial stops at
-its next safe point with a checkpoint, and the sweep ends.
+not run again (``--resume``). Ctrl-C or SIGTERM writes ``sweeps/<name>/STOP``: every running trial
+stops at its next safe point with a checkpoint, and the sweep ends (then Ray is shut down; a driver
+killed outright would leave Ray's workers running).
 
 Local Ray is started here with a fixed CPU count, no dashboard and every service on 127.0.0.1;
 ``address`` joins an existing cluster instead. This module is TensorFlow-free (trials import it).
@@ -28,6 +29,7 @@ from pathlib import Path
 
 from rlcore.atomic import writable_folder, write_json
 from rlcore.errors import UserError
+from rlcore.trainers.stopping import STOP_SIGNALS
 
 SWEEPS_DIR = Path("sweeps")
 SWEEP_FILE = "sweep.json"
@@ -230,11 +232,11 @@ def run_sweep(sweep: Sweep, address: str | None = None, num_cpus: int | None = N
     started = start_ray(address, num_cpus)
     from ray import tune
 
-    def on_sigint(signum, frame):
+    def on_stop_signal(signum, frame):  # Ctrl-C or SIGTERM: a killed driver would orphan Ray's workers
         (folder / STOP_FILE).touch()
-        print("\nCtrl-C: every running trial stops at its next checkpoint; --resume continues the sweep",
-              file=sys.stderr)
-    previous = signal.signal(signal.SIGINT, on_sigint)
+        print(f"\n{STOP_SIGNALS[signum]}: every running trial stops at its next checkpoint; --resume continues "
+              "the sweep", file=sys.stderr)
+    previous = {number: signal.signal(number, on_stop_signal) for number in STOP_SIGNALS}
     try:
         trainable = tune.with_parameters(_trainable, sweep=asdict(sweep),
                                          modules=dict(registry.EXPERIMENT_MODULES),
@@ -250,7 +252,8 @@ def run_sweep(sweep: Sweep, address: str | None = None, num_cpus: int | None = N
                                       failure_config=tune.FailureConfig(max_failures=3)))
         grid = tuner.fit()
     finally:
-        signal.signal(signal.SIGINT, previous)
+        for number, old in previous.items():
+            signal.signal(number, old)
         if started:
             import ray
             ray.shutdown()

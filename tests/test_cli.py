@@ -163,8 +163,10 @@ def test_plot_of_an_unfinished_mario_run(capsys, tmp_path):
     assert all(Path(p).stat().st_size > 1000 for p in written)
 
 
-def test_ctrl_c_saves_a_checkpoint_and_resume_continues(tmp_path):
-    """A real SIGINT to a real training process: exit 130, checkpoint written, resume continues."""
+@pytest.mark.parametrize("signal_name", ["SIGINT", "SIGTERM"])
+def test_ctrl_c_saves_a_checkpoint_and_resume_continues(tmp_path, signal_name):
+    """A real SIGINT (Ctrl-C) or SIGTERM (kill) to a real training process: exit 130, checkpoint
+    written, resume continues."""
     import signal
     import time
 
@@ -178,7 +180,7 @@ def test_ctrl_c_saves_a_checkpoint_and_resume_continues(tmp_path):
     while not (run_dir / "metrics.csv").exists() or len((run_dir / "metrics.csv").read_text().splitlines()) < 4:
         assert time.time() < deadline and proc.poll() is None, proc.stderr.read() if proc.poll() else "slow"
         time.sleep(0.2)
-    proc.send_signal(signal.SIGINT)
+    proc.send_signal(getattr(signal, signal_name))
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130, err
     assert "checkpoint saved to" in err and "Traceback" not in err

@@ -92,13 +92,15 @@ def test_a_killed_trial_resumes_from_its_checkpoint(local_ray, tmp_path):
     assert episodes == list(range(1, len(episodes) + 1)) and len(episodes) >= 400
 
 
-def test_ctrl_c_stops_at_a_checkpoint_and_resume_skips_finished_trials(local_ray, tmp_path):
+@pytest.mark.parametrize("signal_name", ["SIGINT", "SIGTERM"])
+def test_ctrl_c_stops_at_a_checkpoint_and_resume_skips_finished_trials(local_ray, tmp_path, signal_name):
+    """Ctrl-C (SIGINT) or SIGTERM to the sweep's driver."""
     sweep = _sweep(tmp_path, "stop", seeds=(0,), max_episodes=4000, checkpoint_every=5)
     trial = tmp_path / "stop" / "seed=0"
 
     def ctrl_c():
         _wait_for(trial / "checkpoint.npz")
-        os.kill(os.getpid(), signal.SIGINT)  # the sweep's handler writes STOP
+        os.kill(os.getpid(), getattr(signal, signal_name))  # the sweep's handler writes STOP
     threading.Thread(target=ctrl_c, daemon=True).start()
     rows = run_sweep(sweep)
     assert rows[0].get("interrupted") == 1, rows

@@ -6,7 +6,7 @@ It puts together the parts that each own one thing:
     Tracker              CSV tables and wandb                           tracking.py
     Progress             the console bar                                trainers/progress.py
     PeriodicEvaluation   greedy evaluations, best weights               trainers/periodic_eval.py
-    StopRequest          Ctrl-C and a sweep's stop file                 trainers/stopping.py
+    StopRequest          Ctrl-C, SIGTERM and a sweep's stop file        trainers/stopping.py
     StopRules            budgets and goals                              trainers/stopping.py
     write_model_folder   model/ with meta.json                          trainers/model_folder.py
 
@@ -104,7 +104,7 @@ class TrainingSession:
 
     @property
     def stop_requested(self) -> bool:
-        """Ctrl-C or the stop file: stop at the next safe point, checkpoint, raise ``Interrupted``."""
+        """Ctrl-C, SIGTERM or the stop file: stop at the next safe point, checkpoint, raise ``Interrupted``."""
         return self.stop.poll()
 
     def should_stop(self) -> bool:
@@ -115,7 +115,7 @@ class TrainingSession:
         return self.stop_reason is not None
 
     def interruptible(self):
-        return self.stop.catching_ctrl_c()
+        return self.stop.catching_stop_signals()
 
     # ------------------------------------------------------------ checkpoints
     @property

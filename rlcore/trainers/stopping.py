@@ -1,7 +1,7 @@
 """When a run stops. Two kinds of reason, kept apart:
 
-- :class:`StopRequest`: someone asked (Ctrl-C, or a sweep's stop file). The loop stops at its next
-  safe point, writes a checkpoint and raises :class:`Interrupted`; the run can be resumed.
+- :class:`StopRequest`: someone asked (Ctrl-C or SIGTERM, or a sweep's stop file). The loop stops at
+  its next safe point, writes a checkpoint and raises :class:`Interrupted`; the run can be resumed.
 - :class:`StopRules`: the run is done (a budget is spent or a goal reached). It then writes its
   model folder; ``meta.json`` records which rule ended it.
 """
@@ -16,8 +16,12 @@ from pathlib import Path
 from tqdm import tqdm
 
 
+# each asks for a stop at the next safe point, with a checkpoint
+STOP_SIGNALS = {signal.SIGINT: "Ctrl-C", signal.SIGTERM: "SIGTERM"}
+
+
 class Interrupted(Exception):
-    """Raised after Ctrl-C once the checkpoint is safely written."""
+    """Raised after a stop request (Ctrl-C, SIGTERM, a stop file) once the checkpoint is safely written."""
 
     def __init__(self, checkpoint: Path):
         super().__init__(f"interrupted; checkpoint saved to {checkpoint}; continue with --resume {checkpoint.parent}")
@@ -25,7 +29,7 @@ class Interrupted(Exception):
 
 
 class StopRequest:
-    """Ctrl-C or a stop file: ``requested`` turns true, and stays true. The file is looked at no
+    """Ctrl-C, SIGTERM or a stop file: ``requested`` turns true, and stays true. The file is looked at no
     more than once per ``FILE_CHECK_SECONDS`` (loops poll every env step)."""
     FILE_CHECK_SECONDS = 0.5
 
@@ -41,22 +45,24 @@ class StopRequest:
         return self.requested
 
     @contextlib.contextmanager
-    def catching_ctrl_c(self):
-        """First Ctrl-C sets ``requested`` (the loop checkpoints and stops); the second aborts."""
+    def catching_stop_signals(self):
+        """The first Ctrl-C or SIGTERM (``kill``, ``timeout``, a job scheduler) sets ``requested``: the
+        loop checkpoints and stops. A second one aborts without saving."""
         def handler(signum, frame):
             if self.requested:
                 raise KeyboardInterrupt
             self.requested = True
-            tqdm.write("\nCtrl-C: stopping at the next safe point and saving a checkpoint "
-                       "(press again to abort without saving)")
+            tqdm.write(f"\n{STOP_SIGNALS[signum]}: stopping at the next safe point and saving a checkpoint "
+                       "(a second one aborts without saving)")
         if threading.current_thread() is not threading.main_thread():
             yield  # a Ray trial runs in a worker thread: its sweep stops it through the stop file
             return
-        previous = signal.signal(signal.SIGINT, handler)
+        previous = {number: signal.signal(number, handler) for number in STOP_SIGNALS}
         try:
             yield
         finally:
-            signal.signal(signal.SIGINT, previous)
+            for number, old in previous.items():
+                signal.signal(number, old)
 
 
 class StopRules:
