@@ -6,11 +6,10 @@ from pathlib import Path
 
 import keras
 import numpy as np
-import tensorflow as tf
 
 from rlcore.agents.a2c import A2CAgent
-from rlcore.errors import UserError
 from rlcore.trainers import checkpoints
+from rlcore.trainers.divergence import reported_divergence
 from rlcore.trainers.session import TrainingSession
 from rlcore.trainers.spec import RunSpec
 from rlcore.vector import EnvPool, bootstrap_observations
@@ -56,18 +55,10 @@ def train(spec: RunSpec) -> Path:
                     session.end_episode(running[i], losses)
                     running[i] = 0.0
                 obs = next_obs
-            try:
+            with reported_divergence(session, "A2C", "lower the learning rates"):
                 losses = agent.update(buf_obs, buf_actions, buf_rewards, buf_next, buf_term, buf_done)
-            except tf.errors.InvalidArgumentError as exc:
-                if "A2C" not in str(exc):
-                    raise
-                raise UserError(f"training diverged: NaN/Inf in the A2C loss at env step {session.env_steps}; "
-                                "lower the learning rates or resume from the last checkpoint") from None
             session.maybe_evaluate(agent.greedy_actions, agent.get_weights)
             if session.book.episodes >= next_checkpoint:
                 checkpoint()
                 next_checkpoint += cfg.checkpoint_every
-    checkpoint()
-    if session.stop_requested:
-        raise session.interrupted()
-    return session.finish(agent.save, agent.set_weights)
+    return session.conclude(checkpoint, agent.save, agent.set_weights)

@@ -6,12 +6,11 @@ from pathlib import Path
 
 import keras
 import numpy as np
-import tensorflow as tf
 
 from rlcore.agents.dqn import DQNAgent
-from rlcore.errors import UserError
 from rlcore.replay import ReplayMemory
 from rlcore.trainers import checkpoints
+from rlcore.trainers.divergence import reported_divergence
 from rlcore.trainers.session import TrainingSession
 from rlcore.trainers.spec import RunSpec
 
@@ -56,7 +55,8 @@ def train(spec: RunSpec) -> Path:
                 if session.env_steps % update_period == 0 and len(memory) >= max(cfg.batch_size,
                                                                                   cfg.learning_starts):
                     stacked = memory.sample_stacked(cfg.updates_per_call, cfg.batch_size, rng)
-                    losses.append(_train_steps(agent, stacked, session.env_steps))
+                    with reported_divergence(session, "DQN", "lower --lr"):
+                        losses.append(agent.train_steps(*stacked))
                     grad_steps += cfg.updates_per_call
                 session.maybe_evaluate(agent.greedy_actions, agent.q_network.get_weights)
                 if terminated or truncated or session.stop_requested:
@@ -71,22 +71,10 @@ def train(spec: RunSpec) -> Path:
             if session.book.episodes % cfg.checkpoint_every == 0:
                 checkpoint()
     env.close()
-    checkpoint()
-    if session.stop_requested:
-        raise session.interrupted()
-    return session.finish(lambda folder: [agent.save(folder)], agent.q_network.set_weights)
+    return session.conclude(checkpoint, lambda folder: [agent.save(folder)], agent.q_network.set_weights)
 
 
 def step_epsilon(cfg, env_steps: int) -> float:
     """The PyTorch tutorial's schedule: end + (start - end) * exp(-steps / decay_steps)."""
     return cfg.eps_end + (cfg.eps_start - cfg.eps_end) * math.exp(-env_steps / cfg.eps_decay_steps)
 
-
-def _train_steps(agent: DQNAgent, batch, env_steps: int) -> dict:
-    try:
-        return agent.train_steps(*batch)
-    except tf.errors.InvalidArgumentError as exc:
-        if "DQN loss" in str(exc):
-            raise UserError(f"training diverged: the loss became NaN/Inf at env step {env_steps}; "
-                            "lower --lr or resume from the last checkpoint") from None
-        raise

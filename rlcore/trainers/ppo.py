@@ -11,12 +11,12 @@ from pathlib import Path
 
 import keras
 import numpy as np
-import tensorflow as tf
 from tqdm import tqdm
 
 from rlcore.agents.ppo import MODEL_FILE, UPDATE_NAMES, PPOAgent
 from rlcore.errors import UserError
 from rlcore.trainers import checkpoints
+from rlcore.trainers.divergence import reported_divergence
 from rlcore.trainers.session import TrainingSession
 from rlcore.trainers.spec import RunSpec
 from rlcore.vector import EnvPool
@@ -114,13 +114,8 @@ def train(spec: RunSpec) -> Path:
                 obs = next_obs
                 session.advance(n)
             buf.close(agent.values(obs), truncated_values)
-            try:
+            with reported_divergence(session, "PPO", "lower --lr"):
                 losses = agent.update(*buf.arrays(), rng)
-            except tf.errors.InvalidArgumentError as exc:
-                if "PPO" not in str(exc):
-                    raise
-                raise UserError(f"training diverged: NaN/Inf in the PPO loss at env step {session.env_steps}; "
-                                "lower the learning rate or resume from the last checkpoint") from None
             rollouts += 1
             session.log_rollout(rollouts, {"episodes_ended": ended, "successes": flags,
                                            f"max_{progress_key or 'x'}": max_x, **losses})
@@ -133,11 +128,8 @@ def train(spec: RunSpec) -> Path:
             tqdm.write(line + f" | loss {losses['loss']:.3f} entropy {losses['entropy']:.2f}")
             if rollouts % cfg.checkpoint_rollouts == 0:
                 checkpoint()
-    checkpoint()
-    if session.stop_requested:
-        raise session.interrupted()
     # the model's story starts with the run whose weights it started from
-    return session.finish(agent.save, **({"init_from": parent} if parent else {}))
+    return session.conclude(checkpoint, agent.save, **({"init_from": parent} if parent else {}))
 
 
 def init_weights(agent: PPOAgent, folder: str, experiment: str, algo: str) -> dict:

@@ -11,9 +11,9 @@ import keras
 import numpy as np
 
 from rlcore.agents.sac import SACAgent
-from rlcore.errors import UserError
 from rlcore.replay import ReplayMemory
 from rlcore.trainers import checkpoints
+from rlcore.trainers.divergence import reported_divergence
 from rlcore.trainers.session import TrainingSession
 from rlcore.trainers.spec import RunSpec
 
@@ -61,7 +61,8 @@ def train(spec: RunSpec) -> Path:
                 obs = next_obs
                 if session.env_steps >= cfg.learning_starts and session.env_steps % k == 0:
                     stacked = memory.sample_stacked(k, cfg.batch_size, rng)
-                    losses.append(_train_steps(agent, stacked, rng, session.env_steps))
+                    with reported_divergence(session, "SAC", "lower the learning rates"):
+                        losses.append(agent.train_steps(*stacked, rng))
                     grad_steps += k
                 session.maybe_evaluate(agent.greedy_actions, agent.get_weights)
                 if terminated or truncated or session.stop_requested:
@@ -74,15 +75,5 @@ def train(spec: RunSpec) -> Path:
             if session.book.episodes % cfg.checkpoint_every == 0:
                 checkpoint()
     env.close()
-    checkpoint()
-    if session.stop_requested:
-        raise session.interrupted()
-    return session.finish(agent.save, agent.set_weights)
+    return session.conclude(checkpoint, agent.save, agent.set_weights)
 
-
-def _train_steps(agent: SACAgent, batch, rng, env_steps: int) -> dict:
-    try:
-        return agent.train_steps(*batch, rng)
-    except FloatingPointError as exc:
-        raise UserError(f"training diverged: {exc} at env step {env_steps}; "
-                        "lower the learning rates or resume from the last checkpoint") from None

@@ -18,9 +18,7 @@ checkpoint's state and restores from it. A trainer reads like its article's loop
     with session.interruptible():
         while not session.should_stop():
             ...; session.env_steps += n; ...; session.end_episode(ret, extra)
-    checkpoints.save(session, agent, rng, memory, grad_steps=...)
-    if session.stop_requested: raise session.interrupted()
-    return session.finish(agent.save)
+    return session.conclude(checkpoint, agent.save)   # last checkpoint; Interrupted or the model
 """
 from __future__ import annotations
 
@@ -133,6 +131,14 @@ class TrainingSession:
         return self.evaluation.best_arrays()
 
     # ------------------------------------------------------------- the end
+    def conclude(self, checkpoint, save_models, load_weights=None, **record) -> Path:
+        """After the loop: ``checkpoint()`` once more; then raise :class:`Interrupted` if a stop was
+        asked for, else write the model folder (:meth:`finish`) and return it."""
+        checkpoint()
+        if self.stop_requested:
+            raise self.interrupted()
+        return self.finish(save_models, load_weights, **record)
+
     def finish(self, save_models, load_weights=None, **record) -> Path:
         """Write the model folder: ``save_models(folder)`` writes the ``.h5`` files, then meta + plot.
 

@@ -217,3 +217,21 @@ def test_a_run_resumes_from_what_git_keeps_of_it(tmp_path):
     meta = json.loads((ppo_trainer.train(spec) / "meta.json").read_text())
     assert meta["commands"] == ["pytest", "pytest --resume"]
     assert meta["episodes"] >= 30 and meta["env_steps"] > before["env_steps"]
+
+
+NAN_ENVS = {"dqn": toy.SignEnv, "a2c": toy.SignEnv, "ppo": toy.ImageSignEnv, "sac": toy.ReachEnv}
+
+
+@pytest.mark.parametrize("algo", sorted(TRAINERS))
+def test_a_nan_reward_ends_the_run_with_one_clear_error(algo, tmp_path, monkeypatch):
+    """NaN rewards make the loss NaN: the run stops with a UserError naming the env step, not a
+    TensorFlow traceback."""
+    env_class = NAN_ENVS[algo]
+    honest_step = env_class.step
+
+    def nan_step(self, action):
+        obs, _, terminated, truncated, info = honest_step(self, action)
+        return obs, float("nan"), terminated, truncated, info
+    monkeypatch.setattr(env_class, "step", nan_step)
+    with pytest.raises(UserError, match=r"training diverged: .*NaN.* at env step \d+; "):
+        TRAINERS[algo].train(toy.spec(algo, tmp_path))
