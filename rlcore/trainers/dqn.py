@@ -11,6 +11,7 @@ from rlcore.agents.dqn import DQNAgent
 from rlcore.replay import ReplayMemory
 from rlcore.trainers import checkpoints
 from rlcore.trainers.divergence import reported_divergence
+from rlcore.trainers.episodes import episode_means
 from rlcore.trainers.session import TrainingSession
 from rlcore.trainers.spec import RunSpec
 
@@ -65,8 +66,7 @@ def train(spec: RunSpec) -> Path:
                 break
             if cfg.eps_schedule == "episode":
                 epsilon = max(cfg.eps_end, epsilon * cfg.eps_decay)
-            mean_losses = {k: float(np.mean([l[k] for l in losses])) if losses else float("nan")
-                           for k in ("loss", "q_mean")}
+            mean_losses = episode_means(losses, ("loss", "q_mean"))
             session.end_episode(episode_return, {"epsilon": epsilon, "grad_steps": grad_steps, **mean_losses})
             if session.book.episodes % cfg.checkpoint_every == 0:
                 checkpoint()

@@ -6,6 +6,11 @@ import numpy as np
 from tqdm import tqdm
 
 
+def episode_means(reports: list[dict], names: tuple[str, ...]) -> dict[str, float]:
+    """The mean of each named number over an episode's update reports (NaN before the first update)."""
+    return {n: float(np.mean([r[n] for r in reports])) if reports else float("nan") for n in names}
+
+
 class EpisodeBook:
     """Episode returns, the moving average, successes, and the article's console line and wandb keys."""
 

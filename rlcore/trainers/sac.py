@@ -14,6 +14,7 @@ from rlcore.agents.sac import SACAgent
 from rlcore.replay import ReplayMemory
 from rlcore.trainers import checkpoints
 from rlcore.trainers.divergence import reported_divergence
+from rlcore.trainers.episodes import episode_means
 from rlcore.trainers.session import TrainingSession
 from rlcore.trainers.spec import RunSpec
 
@@ -69,8 +70,7 @@ def train(spec: RunSpec) -> Path:
                     break
             if session.stop_requested:  # partial episode: not counted; its transitions stay in replay
                 break
-            names = ("critic_loss", "actor_loss", "alpha", "entropy", "q_mean")
-            means = {n: float(np.mean([l[n] for l in losses])) if losses else float("nan") for n in names}
+            means = episode_means(losses, ("critic_loss", "actor_loss", "alpha", "entropy", "q_mean"))
             session.end_episode(episode_return, {"grad_steps": grad_steps, **means})
             if session.book.episodes % cfg.checkpoint_every == 0:
                 checkpoint()
