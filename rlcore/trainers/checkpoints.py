@@ -1,14 +1,27 @@
-"""A run's checkpoint: weights, optimizers, RNG, the session's counters, the trainer's own counters,
-kept best weights and (off-policy trainers) the whole replay memory, in one atomic file. Every
-trainer saves and restores through these two functions."""
+"""A run's checkpoint: weights, optimizers, RNG, the session's counters, the trainer's own counters and
+the kept best weights in ``checkpoint.npz``; an off-policy trainer's replay memory beside it in
+``replay.npz``. Every trainer saves and restores through these two functions.
+
+The replay memory has its own file because it is large (1M Minitaur transitions: ~260 MB) and git
+should not keep it: ``long_runs/`` commits ``checkpoint.npz`` only. A run resumed where its
+``replay.npz`` is missing (a clone on another machine), or is from another moment than the checkpoint
+(a crash between the two writes), continues with an empty memory, which refills before learning goes
+on; it says so in one line.
+"""
 from __future__ import annotations
+
+import sys
+from pathlib import Path
 
 import numpy as np
 
+from rlcore.atomic import atomic_path
 from rlcore.checkpoint import load_checkpoint, save_checkpoint
 from rlcore.replay import ReplayMemory
 from rlcore.trainers.session import TrainingSession
 from rlcore.trainers.spec import CHECKPOINT_FILE, RunSpec, check_resumable
+
+REPLAY_FILE = "replay.npz"
 
 
 def restore(spec: RunSpec, agent, rng: np.random.Generator,
@@ -20,7 +33,7 @@ def restore(spec: RunSpec, agent, rng: np.random.Generator,
     check_resumable(spec)
     state, arrays = load_checkpoint(spec.run_dir / CHECKPOINT_FILE, agent.models(), agent.optimizers())
     if memory is not None:
-        memory.load_state_dict({k[len("replay/"):]: v for k, v in arrays.items() if k.startswith("replay/")})
+        _restore_replay(spec.run_dir, state, arrays, memory)
     rng.bit_generator.state = state["rng"]
     agent.sync_policy_weights()  # the numpy acting copy, where the agent keeps one
     return state, arrays
@@ -28,7 +41,31 @@ def restore(spec: RunSpec, agent, rng: np.random.Generator,
 
 def save(session: TrainingSession, agent, rng: np.random.Generator, memory: ReplayMemory | None = None,
          **counters) -> None:
-    """Write the checkpoint; ``counters``: the trainer's own (epsilon, grad_steps, rollouts, ...)."""
-    replay = {f"replay/{k}": v for k, v in memory.state_dict().items()} if memory is not None else {}
+    """Write the checkpoint (and the replay memory first, stamped with the same env step count);
+    ``counters``: the trainer's own (epsilon, grad_steps, rollouts, ...)."""
+    if memory is not None:
+        with atomic_path(session.run_dir / REPLAY_FILE) as tmp, open(tmp, "wb") as f:
+            np.savez(f, env_steps=np.array(session.env_steps), **memory.state_dict())
+        counters["replay_env_steps"] = session.env_steps
     save_checkpoint(session.checkpoint_path, agent.models(), agent.optimizers(),
-                    session.state(rng=rng.bit_generator.state, **counters), {**replay, **session.best_arrays()})
+                    session.state(rng=rng.bit_generator.state, **counters), session.best_arrays())
+
+
+def _restore_replay(run_dir: Path, state: dict, arrays: dict, memory: ReplayMemory) -> None:
+    inline = {k[len("replay/"):]: v for k, v in arrays.items() if k.startswith("replay/")}
+    if inline:  # a checkpoint written when the replay memory was still inside it
+        memory.load_state_dict(inline)
+        return
+    path = run_dir / REPLAY_FILE
+    try:
+        with np.load(path) as data:
+            found = {key: data[key] for key in data.files}
+    except (OSError, ValueError) as exc:
+        why = "is not there" if not path.exists() else f"is damaged ({type(exc).__name__})"
+    else:
+        if int(found.pop("env_steps", -1)) == state.get("replay_env_steps"):
+            memory.load_state_dict(found)
+            return
+        why = "is from another moment than the checkpoint"
+    print(f"resume: the replay memory {path} {why}; training goes on with an empty one, which refills "
+          "before learning resumes", file=sys.stderr)

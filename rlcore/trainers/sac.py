@@ -1,7 +1,8 @@
 """Step loop for SAC: one env step per gradient step, after ``learning_starts`` random steps.
 
 Like TF-Agents' driver, a time-limit truncation still bootstraps (only ``terminated``, a fall,
-stops it). Checkpoints hold the whole replay memory, so a resumed run continues where it stopped.
+stops it). The replay memory is saved beside each checkpoint (``replay.npz``), so a resumed run
+continues where it stopped; without that file it continues with an empty memory that refills first.
 """
 from __future__ import annotations
 
@@ -60,7 +61,8 @@ def train(spec: RunSpec) -> Path:
                 session.env_steps += 1
                 episode_return += reward
                 obs = next_obs
-                if session.env_steps >= cfg.learning_starts and session.env_steps % k == 0:
+                # len(memory): after a resume without its replay file, the memory refills first
+                if len(memory) >= max(cfg.learning_starts, cfg.batch_size) and session.env_steps % k == 0:
                     stacked = memory.sample_stacked(k, cfg.batch_size, rng)
                     with reported_divergence(session, "SAC", "lower the learning rates"):
                         losses.append(agent.train_steps(*stacked, rng))

@@ -187,9 +187,13 @@ def test_init_from_a_model_of_another_experiment_is_refused(tmp_path):
         ppo_trainer.train(toy.spec("ppo", tmp_path / "c", init_from=str(tmp_path)))
 
 
-def test_a_run_resumes_from_what_git_keeps_of_it(tmp_path):
-    """long_runs/: the checkpoint and CSV tables are committed, the wandb folder is ignored; a clone
-    on another machine resumes the run with its counters."""
+GIT_KEEPS = {"ppo": ["checkpoint.npz", "metrics.csv", "rollouts.csv"], "sac": ["checkpoint.npz", "metrics.csv"]}
+
+
+@pytest.mark.parametrize("algo", sorted(GIT_KEEPS))
+def test_a_run_resumes_from_what_git_keeps_of_it(tmp_path, algo, capfd):
+    """long_runs/: the checkpoint and CSV tables are committed, the wandb folder and the replay memory
+    are ignored; a clone on another machine resumes the run with its counters."""
     import shutil
     import subprocess
 
@@ -200,23 +204,27 @@ def test_a_run_resumes_from_what_git_keeps_of_it(tmp_path):
                        capture_output=True)
 
     repo = tmp_path / "repo"
-    run_dir = repo / "long_runs" / "toy_image" / "ppo"
-    spec = toy.spec("ppo", tmp_path, stop_score=99.0, max_episodes=30, stop_success_share=0.0)
+    run_dir = repo / "long_runs" / "toy" / algo
+    extra = {"ppo": {"stop_success_share": 0.0}, "sac": {"max_env_steps": 0, "learning_starts": 100}}[algo]
+    spec = toy.spec(algo, tmp_path, stop_score=99.0, max_episodes=30, **extra)
     spec.run_dir, spec.wandb_mode = run_dir, "offline"
-    _interrupt_after(12, ppo_trainer, spec)
+    _interrupt_after(12, TRAINERS[algo], spec)
     assert (run_dir / "wandb").is_dir()
     shutil.copyfile(ROOT / ".gitignore", repo / ".gitignore")
     git("init", "-q", cwd=repo)
     git("add", "-A", cwd=repo)
     git("commit", "-q", "-m", "checkpoint", cwd=repo)
     git("clone", "-q", str(repo), str(tmp_path / "clone"), cwd=tmp_path)
-    cloned = tmp_path / "clone" / "long_runs" / "toy_image" / "ppo"
-    assert sorted(p.name for p in cloned.iterdir()) == ["checkpoint.npz", "metrics.csv", "rollouts.csv"]
+    cloned = tmp_path / "clone" / "long_runs" / "toy" / algo
+    assert sorted(p.name for p in cloned.iterdir()) == GIT_KEEPS[algo]
     before = read_checkpoint_state(cloned / "checkpoint.npz")
     spec.run_dir, spec.resume, spec.wandb_mode, spec.command = cloned, True, "off", "pytest --resume"
-    meta = json.loads((ppo_trainer.train(spec) / "meta.json").read_text())
+    capfd.readouterr()
+    meta = json.loads((TRAINERS[algo].train(spec) / "meta.json").read_text())
     assert meta["commands"] == ["pytest", "pytest --resume"]
     assert meta["episodes"] >= 30 and meta["env_steps"] > before["env_steps"]
+    said = capfd.readouterr().err
+    assert ("replay memory" in said) == (algo == "sac"), said
 
 
 NAN_ENVS = {"dqn": toy.SignEnv, "a2c": toy.SignEnv, "ppo": toy.ImageSignEnv, "sac": toy.ReachEnv}
@@ -255,3 +263,46 @@ def test_a_seed_reproduces_its_run_and_another_seed_does_not(algo, tmp_path):
     first, again, other = metrics("a", 0), metrics("b", 0), metrics("c", 1)
     pd.testing.assert_frame_equal(first, again)
     assert not first["total_points"].equals(other["total_points"])
+
+
+@pytest.mark.parametrize("algo", ["dqn", "sac"])
+def test_the_replay_memory_resumes_from_its_own_file_only_when_it_matches(algo, tmp_path, capfd):
+    """replay.npz beside checkpoint.npz: put back exactly when it is from the checkpoint's moment;
+    missing or from another moment, the memory starts empty and one line says so."""
+    import shutil
+
+    from rlcore.agents.dqn import DQNAgent
+    from rlcore.agents.sac import SACAgent
+    from rlcore.replay import ReplayMemory
+    from rlcore.trainers import checkpoints
+
+    extra = {"sac": {"max_env_steps": 0, "learning_starts": 100}}.get(algo, {})
+    spec = toy.spec(algo, tmp_path, stop_score=99.0, max_episodes=30, **extra)
+    _interrupt_after(12, TRAINERS[algo], spec)
+    replay = spec.run_dir / checkpoints.REPLAY_FILE
+    with np.load(spec.run_dir / "checkpoint.npz") as data:
+        assert not [k for k in data.files if "replay" in k], "the replay memory is inside the checkpoint"
+    state = read_checkpoint_state(spec.run_dir / "checkpoint.npz")
+    shutil.copyfile(replay, tmp_path / "kept.npz")
+    spec.resume = True
+
+    def restored_size():
+        """Restore into a fresh agent and memory (the toy tasks: 2-d observations, 2 actions)."""
+        agent = {"dqn": DQNAgent, "sac": SACAgent}[algo](2, 2, spec.config)
+        action = {"dqn": {}, "sac": {"action_shape": (2,), "action_dtype": np.float32}}[algo]
+        memory = ReplayMemory(spec.config.buffer_size, (2,), **action)
+        capfd.readouterr()
+        checkpoints.restore(spec, agent, np.random.default_rng(0), memory)
+        return len(memory), capfd.readouterr().err
+
+    assert restored_size() == (state["env_steps"], "")
+    replay.unlink()
+    size, said = restored_size()
+    assert size == 0 and "replay memory" in said and "is not there" in said
+    with np.load(tmp_path / "kept.npz") as data:
+        stale = {k: data[k] for k in data.files}
+    np.savez(replay, **{**stale, "env_steps": np.array(state["env_steps"] - 1)})
+    size, said = restored_size()
+    assert size == 0 and "from another moment" in said
+    meta = json.loads((TRAINERS[algo].train(spec) / "meta.json").read_text())  # and the run goes on
+    assert meta["episodes"] >= 30
