@@ -84,6 +84,9 @@ def parse_seeds(text: str) -> list[int]:
         try:
             if "-" in part:
                 low, high = (int(x) for x in part.split("-", 1))
+                if high < low:
+                    raise UserError(f"--seeds {text!r} is invalid: the range {part} runs downward; "
+                                    f"write {high}-{low}")
                 seeds.extend(range(low, high + 1))
             elif part:
                 seeds.append(int(part))

@@ -157,6 +157,7 @@ def test_seeds_and_grid_parsing():
     (["sweep", "lunar_lander", "dqn", "--grid", "lr=fast"], "--grid 'lr=fast' is invalid"),
     (["sweep", "lunar_lander", "dqn", "--grid", "keep_best=maybe"], "--grid 'keep_best=maybe' is invalid: 'maybe'"),
     (["sweep", "lunar_lander", "dqn", "--seeds", "4-x"], "--seeds '4-x' is invalid"),
+    (["sweep", "lunar_lander", "dqn", "--seeds", "4-0"], "the range 4-0 runs downward; write 0-4"),
     (["report", "/nonexistent/sweep"], "no sweep folder /nonexistent/sweep"),
 ])
 def test_bad_sweep_values_are_one_line_and_exit_2(capsys, tmp_path, monkeypatch, argv, message):
