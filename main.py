@@ -11,9 +11,11 @@ TensorFlow is imported only inside the commands that need it, so `list` and `--h
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
 import sys
+import tempfile
 from pathlib import Path
 
 os.environ.setdefault("TF_CPP_MIN_LOG_LEVEL", "2")
@@ -98,8 +100,12 @@ def _model_dir(args) -> Path:
     exp = get_experiment(args.experiment)
     exp.algo(args.algo)  # unknown names -> clear error
     level = (args.world, args.stage)
+    if level == (None, None) and args.model:
+        folder = Path(args.model)
+        finished = folder / "model"  # a finished run's folder: its model
+        return finished if (finished / "meta.json").is_file() and not (folder / "meta.json").is_file() else folder
     if level == (None, None):
-        return Path(args.model) if args.model else shipping.shipped_dir(args.experiment, args.algo)
+        return shipping.shipped_dir(args.experiment, args.algo)
     if not exp.ship_by:
         raise UserError(f"--world/--stage choose a Mario level; {exp.name} ships one model per algorithm")
     if args.model:
@@ -115,18 +121,37 @@ def _model_dir(args) -> Path:
     return folder
 
 
+@contextlib.contextmanager
+def _model(args):
+    """Yield ``(model folder, its name for the console)``: the chosen model folder, or for a run in
+    progress (a checkpoint, no model yet) a snapshot of its last checkpoint in a temporary folder."""
+    from rlcore.snapshot import is_run_in_progress, model_from_checkpoint
+
+    folder = _model_dir(args)
+    if not is_run_in_progress(folder):
+        yield folder, str(folder)
+        return
+    if getattr(args, "record", False):
+        raise UserError(f"--record writes into a model folder; {folder} is a run in progress, which has none")
+    with tempfile.TemporaryDirectory(prefix="snapshot-") as tmp:
+        meta = model_from_checkpoint(folder, tmp, args.experiment, args.algo)
+        print(f"model:   the last checkpoint of {folder} (episode {meta['episodes']:,}, "
+              f"env step {meta['env_steps']:,})")
+        yield Path(tmp), f"{folder}, last checkpoint"
+
+
 def cmd_evaluate(args) -> int:
     from rlcore.policies import load_policy
 
-    model_dir = _model_dir(args)
-    exp, meta, policy = load_policy(model_dir, args.experiment, args.algo)
-    episodes = shipping.eval_episodes(exp, args.episodes)
-    if args.record:
-        shipping.evaluate_into_meta(model_dir, episodes, args.seed_base)
-        print(f"recorded in {model_dir / 'meta.json'}")
-        return 0
-    _, line = shipping.run_evaluation(exp, policy, episodes, args.seed_base)
-    print(f"{exp.name} {args.algo} ({model_dir}): {line}")
+    with _model(args) as (model_dir, name):
+        exp, meta, policy = load_policy(model_dir, args.experiment, args.algo)
+        episodes = shipping.eval_episodes(exp, args.episodes)
+        if args.record:
+            shipping.evaluate_into_meta(model_dir, episodes, args.seed_base)
+            print(f"recorded in {model_dir / 'meta.json'}")
+            return 0
+        _, line = shipping.run_evaluation(exp, policy, episodes, args.seed_base)
+    print(f"{exp.name} {args.algo} ({name}): {line}")
     return 0
 
 
@@ -144,17 +169,20 @@ def _render(model_dir: Path, out: Path, fps: int | None, episodes: int | None, s
 
 
 def cmd_render(args) -> int:
-    model_dir = _model_dir(args)
     from rlcore.policies import load_policy
-    load_policy(model_dir, args.experiment, args.algo)  # checks before any file is written
-    name = f"{args.experiment}_{args.algo}" + (f"_{model_dir.name}" if args.world or args.stage else "")
+
+    name = f"{args.experiment}_{args.algo}"
+    if args.world or args.stage:
+        name += f"_{args.world or 1}-{args.stage or 1}"
     out = Path(args.out) if args.out else Path("videos") / f"{name}.mp4"
     if out.is_dir():
         out = out / f"{name}.mp4"
     if out.suffix.lower() != ".mp4":
         raise UserError(f"--out {out}: give a file name ending in .mp4, or a folder")
-    writable_folder(out.parent, "--out")
-    _render(model_dir, out, args.fps, args.episodes, args.seed)
+    with _model(args) as (model_dir, _):
+        load_policy(model_dir, args.experiment, args.algo)  # checks before any file is written
+        writable_folder(out.parent, "--out")
+        _render(model_dir, out, args.fps, args.episodes, args.seed)
     return 0
 
 
@@ -282,7 +310,8 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
         p.add_argument("experiment")
         p.add_argument("algo")
         p.add_argument("--model", default=None,
-                       help="model folder (default saved_networks/EXPERIMENT/ALGO)")
+                       help="model folder, a finished run's folder, or a run in progress (its last "
+                            "checkpoint) (default saved_networks/EXPERIMENT/ALGO)")
         p.add_argument("--world", type=int, default=None, help="Mario: the shipped model of this world "
                        "(default 1)")
         p.add_argument("--stage", type=int, default=None, help="Mario: the shipped model of this stage "

@@ -229,3 +229,26 @@ def test_evaluate_a_mario_level_by_world_and_stage(capsys, tmp_path, monkeypatch
                          "--episodes", "1")
     assert code == 0, err
     assert f"saved_networks/mario_ppo/1-1): flag_get in " in out
+
+
+def test_evaluate_and_render_a_run_in_progress_and_a_finished_run_folder(capsys, tmp_path, monkeypatch):
+    """--model RUN_DIR: a run without a model plays its last checkpoint (and --record is refused);
+    a finished run's folder plays its model/."""
+    from tests.rlcore.test_training import _interrupt_after
+    from rlcore.trainers import dqn as dqn_trainer
+
+    monkeypatch.setitem(registry.EXPERIMENT_MODULES, "toy", "tests.toy")
+    spec = toy.spec("dqn", tmp_path, max_episodes=30, stop_score=99.0)
+    _interrupt_after(12, dqn_trainer, spec)
+    code, out, err = run(capsys, "evaluate", "toy", "dqn", "--model", str(spec.run_dir), "--episodes", "3")
+    assert code == 0, err
+    assert f"the last checkpoint of {spec.run_dir} (episode 12," in out and "last checkpoint): " in out
+    code, _, err = run(capsys, "evaluate", "toy", "dqn", "--model", str(spec.run_dir), "--record")
+    assert code == 2 and "is a run in progress" in err
+    code, out, err = run(capsys, "render", "toy", "dqn", "--model", str(spec.run_dir), "--episodes", "1",
+                         "--out", str(tmp_path / "in_progress.mp4"))
+    assert code == 0 and (tmp_path / "in_progress.mp4").stat().st_size > 0, err
+    spec.resume = True
+    dqn_trainer.train(spec)  # finishes: model/ appears
+    code, out, err = run(capsys, "evaluate", "toy", "dqn", "--model", str(spec.run_dir), "--episodes", "3")
+    assert code == 0 and f"({spec.run_dir / 'model'}): " in out, err

@@ -306,3 +306,31 @@ def test_the_replay_memory_resumes_from_its_own_file_only_when_it_matches(algo, 
     assert size == 0 and "from another moment" in said
     meta = json.loads((TRAINERS[algo].train(spec) / "meta.json").read_text())  # and the run goes on
     assert meta["episodes"] >= 30
+
+
+ACTING_MODEL = {"dqn": "q_network", "a2c": "actor", "ppo": "actor_critic", "sac": "actor"}
+
+
+@pytest.mark.parametrize("algo", sorted(TRAINERS))
+def test_a_run_in_progress_becomes_a_model_of_its_last_checkpoint(algo, tmp_path):
+    """evaluate/render --model RUN_DIR on a run without a model yet: the acting network is the
+    checkpoint's, and the run folder is left as it was."""
+    from rlcore.snapshot import is_run_in_progress, model_from_checkpoint
+
+    extra = {"ppo": {"stop_success_share": 0.0}, "sac": {"max_env_steps": 0, "learning_starts": 100}}
+    spec = toy.spec(algo, tmp_path, stop_score=99.0, max_episodes=30, **extra.get(algo, {}))
+    _interrupt_after(12, TRAINERS[algo], spec)
+    assert is_run_in_progress(spec.run_dir)
+    files_before = sorted(p.name for p in spec.run_dir.iterdir())
+    with pytest.raises(UserError, match=f"is {spec.experiment.name} {algo}, not {spec.experiment.name} nothing"):
+        model_from_checkpoint(spec.run_dir, tmp_path / "no", spec.experiment.name, "nothing")
+    meta = model_from_checkpoint(spec.run_dir, tmp_path / "snap", spec.experiment.name, algo)
+    state = read_checkpoint_state(spec.run_dir / "checkpoint.npz")
+    assert meta["env_steps"] == state["env_steps"] and meta["episodes"] == len(state["returns"])
+    _, _, policy = load_policy(tmp_path / "snap", spec.experiment.name, algo)
+    with np.load(spec.run_dir / "checkpoint.npz") as data:
+        name = ACTING_MODEL[algo]
+        saved = [data[f"model/{name}/{i}"] for i in range(len(policy.model.get_weights()))]
+    for got, want in zip(policy.model.get_weights(), saved):
+        np.testing.assert_array_equal(got, want)
+    assert sorted(p.name for p in spec.run_dir.iterdir()) == files_before

@@ -1,0 +1,58 @@
+"""A model folder made from a run's last checkpoint, so ``evaluate`` and ``render`` work on a run that
+is still training or was stopped (``--model long_runs/mario_ppo/2-1``), as RL Zoo's
+``enjoy --load-checkpoint`` does. The folder holds the acting network(s) and a ``meta.json`` that
+names the checkpoint it came from; nothing is written into the run folder.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+from rlcore.atomic import write_json
+from rlcore.checkpoint import load_checkpoint, read_checkpoint_state
+from rlcore.errors import UserError
+from rlcore.experiment import get_experiment
+from rlcore.policies import config_from_meta
+from rlcore.trainers.spec import CHECKPOINT_FILE
+
+
+def _agent(kind: str, observation_space, action_space, cfg):
+    """An untrained agent of ``kind`` for these spaces, built as its trainer builds it."""
+    if kind == "dqn":
+        from rlcore.agents.dqn import DQNAgent
+        return DQNAgent(observation_space.shape[0], int(action_space.n), cfg)
+    if kind == "a2c":
+        from rlcore.agents.a2c import A2CAgent
+        return A2CAgent(observation_space.shape[0], int(action_space.n), cfg)
+    if kind == "ppo":
+        from rlcore.agents.ppo import PPOAgent
+        return PPOAgent(observation_space.shape, int(action_space.n), cfg)
+    from rlcore.agents.sac import SACAgent
+    return SACAgent(observation_space.shape[0], action_space.shape[0], cfg)
+
+
+def is_run_in_progress(folder: str | Path) -> bool:
+    """A run folder with a checkpoint and no finished model of its own."""
+    folder = Path(folder)
+    return (folder / CHECKPOINT_FILE).is_file() and not (folder / "meta.json").is_file()
+
+
+def model_from_checkpoint(run_dir: str | Path, out_dir: str | Path, experiment: str, algo: str) -> dict:
+    """Write the acting network(s) of ``run_dir``'s checkpoint and a meta.json to ``out_dir``; return
+    the meta. The run must be one of ``experiment`` ``algo``."""
+    run_dir, out_dir = Path(run_dir), Path(out_dir)
+    state = read_checkpoint_state(run_dir / CHECKPOINT_FILE)
+    if (state.get("experiment"), state.get("algo")) != (experiment, algo):
+        raise UserError(f"the run in {run_dir} is {state.get('experiment')} {state.get('algo')}, "
+                        f"not {experiment} {algo}")
+    exp = get_experiment(state["experiment"])
+    cfg = config_from_meta(exp, state)
+    env = exp.env_factory(cfg, max_episode_steps=None)()
+    agent = _agent(exp.algo(state["algo"]).kind, env.observation_space, env.action_space, cfg)
+    env.close()
+    load_checkpoint(run_dir / CHECKPOINT_FILE, agent.models(), {})
+    agent.save(out_dir)
+    meta = {key: state[key] for key in ("experiment", "algo", "kind", "preset", "seed", "config", "env_steps",
+                                        "commands") if key in state}
+    meta.update(episodes=len(state.get("returns", [])), snapshot_of=str(run_dir / CHECKPOINT_FILE))
+    write_json(out_dir / "meta.json", meta)
+    return meta
