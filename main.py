@@ -323,7 +323,8 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
             p.add_argument("--record", action="store_true",
                            help="write the result into the model folder's meta.json as its evaluation")
         else:
-            p.add_argument("--out", default=None, help="MP4 path, or a folder for it (default videos/EXPERIMENT_ALGO.mp4)")
+            p.add_argument("--out", default=None,
+                           help="MP4 path, or a folder for it (default videos/EXPERIMENT_ALGO.mp4)")
             p.add_argument("--fps", type=whole_number(Allowed(low=1, high=240)), default=None,
                            help="frames per second (default: experiment's)")
             p.add_argument("--episodes", type=COUNT, default=None, help="default 1; Minitaur 3")
