@@ -27,7 +27,7 @@ def plot_run(run_dir: str | Path, out_dir: str | Path, experiment, about: dict) 
         raise UserError(f"{run_dir}: its checkpoint or meta.json lacks {', '.join(missing)}; "
                         "not a run of this package")
     run_dir, out_dir, algo = Path(run_dir), Path(out_dir), about["algo"]
-    title = f"{experiment.name} {algo} ({about['preset']} preset, seed {about['seed']})"
+    title = plot_title(experiment, about)
     window = about["config"].get("window", 100)
     prefix = experiment.plot_prefix or experiment.name
     label = experiment.score_label
@@ -41,6 +41,13 @@ def plot_run(run_dir: str | Path, out_dir: str | Path, experiment, about: dict) 
         out.append(plot_evaluations(evals, out_dir / f"{prefix}_Eval_{algo}.png", title,
                                     experiment.solved_score, label))
     return out
+
+
+def plot_title(experiment, about: dict) -> str:
+    """What trained: experiment, algorithm, the level for one-model-per-level experiments, preset, seed."""
+    level = "-".join(str(about["config"].get(f)) for f in experiment.ship_by)  # Mario: "2-1"
+    return (f"{experiment.name} {about['algo']}{' ' + level if level else ''} "
+            f"({about['preset']} preset, seed {about['seed']})")
 
 
 def plot_episode_scores(csv_path: str | Path, png_path: str | Path, title: str,

@@ -252,3 +252,13 @@ def test_evaluate_and_render_a_run_in_progress_and_a_finished_run_folder(capsys,
     dqn_trainer.train(spec)  # finishes: model/ appears
     code, out, err = run(capsys, "evaluate", "toy", "dqn", "--model", str(spec.run_dir), "--episodes", "3")
     assert code == 0 and f"({spec.run_dir / 'model'}): " in out, err
+
+
+def test_a_plot_title_names_the_mario_level():
+    from rlcore.experiment import get_experiment
+    from rlcore.plotting import plot_title
+
+    about = {"algo": "ppo", "preset": "default", "seed": 0, "config": {"world": 2, "stage": 1}}
+    assert plot_title(get_experiment("mario_ppo"), about) == "mario_ppo ppo 2-1 (default preset, seed 0)"
+    about = {"algo": "dqn", "preset": "article", "seed": 3, "config": {}}
+    assert plot_title(get_experiment("lunar_lander"), about) == "lunar_lander dqn (article preset, seed 3)"
