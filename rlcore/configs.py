@@ -22,6 +22,9 @@ def _h(default, text, allowed: Allowed | None = None):
 def _batch_fits_replay(cfg) -> None:
     require(cfg.batch_size <= cfg.buffer_size, f"--batch-size {cfg.batch_size} is invalid: it must not "
                                                f"exceed --buffer-size {cfg.buffer_size}")
+    # learning waits for this many stored transitions; a smaller memory would never hold them
+    require(cfg.learning_starts <= cfg.buffer_size, f"--learning-starts {cfg.learning_starts} is invalid: "
+                                                    f"it must not exceed --buffer-size {cfg.buffer_size}")
 
 
 @dataclass(frozen=True)

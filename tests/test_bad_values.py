@@ -27,6 +27,10 @@ BAD_VALUES = [
     (["train", "lunar_lander", "dqn", "--steps", "0"], "argument --steps: 0 is invalid"),
     (["train", "lunar_lander", "dqn", "--final-eval-episodes", "-1"], "argument --final-eval-episodes: -1"),
     (["train", "minitaur", "sac", "--learning-starts", "-5"], "--learning-starts -5 is invalid"),
+    (["train", "minitaur", "sac", "--buffer-size", "5000"],
+     "--learning-starts 10000 is invalid: it must not exceed --buffer-size 5000"),
+    (["train", "lunar_lander", "dqn", "--learning-starts", "200000", "--buffer-size", "100000"],
+     "--learning-starts 200000 is invalid: it must not exceed --buffer-size 100000"),
     # probabilities, discount, tau, lambda, clip
     (["train", "lunar_lander", "dqn", "--gamma", "1.5"], "--gamma 1.5 is invalid: allowed is a number from 0 to 1"),
     (["train", "lunar_lander", "dqn", "--tau", "0"], "--tau 0.0 is invalid: allowed is a number above 0 and at most 1"),
