@@ -43,7 +43,8 @@ def test_standardize_layer_and_its_numpy_step_match_the_reference():
 
 
 def test_sac_pushes_the_statistics_into_all_five_networks_before_an_update():
-    cfg = SACConfig(actor_hidden=(8,), critic_hidden=(8,), batch_size=4, buffer_size=8, obs_norm=True)
+    cfg = SACConfig(actor_hidden=(8,), critic_hidden=(8,), batch_size=4, buffer_size=8, learning_starts=8,
+                    obs_norm=True)
     agent = SACAgent(3, 2, cfg)
     rng = np.random.default_rng(2)
     agent.observe(rng.normal(5.0, 2.0, size=(50, 3)))
