@@ -7,7 +7,18 @@ from tqdm import tqdm
 
 def evaluate(experiment, policy, episodes: int = 100, seed_base: int | None = None,
              max_episode_steps: int | None = None, progress: bool = True, make_env=None) -> np.ndarray:
-    """Play ``episodes`` greedy episodes, episode i seeded ``seed_base + i``; return the returns.
+    """Play ``episodes`` greedy episodes, episode i seeded ``seed_base + i``; return the returns in
+    seed order. The arguments are those of :func:`play_greedy`."""
+    records = play_greedy(experiment, policy, episodes, seed_base, max_episode_steps, progress, make_env)
+    return np.asarray([r["return"] for r in records])
+
+
+def play_greedy(experiment, policy, episodes: int = 100, seed_base: int | None = None,
+                max_episode_steps: int | None = None, progress: bool = True, make_env=None,
+                info_keys: tuple[str, ...] = ()) -> list[dict]:
+    """Play ``episodes`` greedy episodes, episode i seeded ``seed_base + i``; one record per
+    episode in seed order: seed, return, length, ``time_limit`` (it lasted until the time limit
+    rather than ending in the env, a fall say) and the final value of each of ``info_keys``.
 
     ``max_episode_steps=None`` keeps the env's registered time limit; ``make_env()``, when given,
     builds the env instead (a saved model's own level, say).
@@ -22,28 +33,34 @@ def evaluate(experiment, policy, episodes: int = 100, seed_base: int | None = No
     envs = gym.vector.SyncVectorEnv(
         [make_env for _ in range(width)],
         autoreset_mode=gym.vector.AutoresetMode.SAME_STEP)
-    returns, next_seed = [], 0
+    records = []
     obs, _ = envs.reset(seed=[seed_base + i for i in range(width)])
-    next_seed = width
-    running = np.zeros(width)
+    slot_seed = list(range(seed_base, seed_base + width))  # the seed of each env's current episode
+    next_seed = seed_base + width
+    running, length = np.zeros(width), np.zeros(width, int)
     active = np.ones(width, bool)  # envs still owed an episode
     bar = tqdm(total=episodes, unit="ep", desc="evaluate", disable=None if progress else True,
                leave=False)
     while active.any():
-        obs, reward, terminated, truncated, _ = envs.step(policy(obs))
+        obs, reward, terminated, truncated, info = envs.step(policy(obs))
         running += reward
+        length += 1
         for i in np.flatnonzero((terminated | truncated) & active):
-            returns.append(running[i])
-            running[i] = 0.0
+            final = info.get("final_info", {})
+            record = {"seed": slot_seed[i], "return": float(running[i]), "length": int(length[i]),
+                      "time_limit": bool(truncated[i] and not terminated[i])}
+            record.update({k: float(final[k][i]) for k in info_keys if k in final})
+            records.append(record)
+            running[i], length[i] = 0.0, 0
             bar.update(1)
-            if next_seed < episodes:  # the auto-reset episode gets a fresh evaluation seed
-                obs[i], _ = envs.envs[i].reset(seed=seed_base + next_seed)
-                next_seed += 1
+            if next_seed < seed_base + episodes:  # the auto-reset episode gets a fresh evaluation seed
+                obs[i], _ = envs.envs[i].reset(seed=next_seed)
+                slot_seed[i], next_seed = next_seed, next_seed + 1
             else:
                 active[i] = False
     bar.close()
     envs.close()
-    return np.asarray(returns[:episodes])
+    return sorted(records, key=lambda r: r["seed"])
 
 
 def evaluate_success(make_env, act, episodes: int, seed_base: int, success_key: str,

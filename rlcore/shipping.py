@@ -5,6 +5,8 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
+import numpy as np
+
 #: the repository's saved_networks/, wherever the command is run from
 SAVED_NETWORKS = Path(__file__).resolve().parents[1] / "saved_networks"
 
@@ -62,14 +64,23 @@ def run_evaluation(exp, policy, episodes: int, seed_base: int | None) -> tuple[d
             line += (f"; {progress_key} mean {summary[f'mean_{progress_key}']:.0f}, "
                      f"max {summary[f'max_{progress_key}']:.0f}")
         return summary, line + f" (seeds {seeds}, actions sampled from pi)"
-    from rlcore.evaluation import evaluate
+    from rlcore.evaluation import play_greedy
 
-    returns = evaluate(exp, policy, episodes, seed_base, make_env=policy.make_env)
+    records = play_greedy(exp, policy, episodes, seed_base, make_env=policy.make_env,
+                          info_keys=exp.eval_info_keys)
+    returns = np.array([r["return"] for r in records])
+    full = sum(r["time_limit"] for r in records)
     summary = {"episodes": episodes, "mean": round(float(returns.mean()), 2),
                "std": round(float(returns.std()), 2), "min": round(float(returns.min()), 2),
-               "seeds": seeds, "policy": "greedy"}
+               "time_limit_share": round(full / episodes, 3), "seeds": seeds, "policy": "greedy",
+               "per_episode": records}
     line = (f"greedy return {returns.mean():.1f} +- {returns.std():.1f} over {len(returns)} episodes "
-            f"(min {returns.min():.1f}, max {returns.max():.1f})")
+            f"(min {returns.min():.1f}, max {returns.max():.1f}); {full}/{episodes} lasted to the time limit")
+    for key in exp.eval_info_keys:
+        values = [r[key] for r in records if key in r]
+        if values:
+            summary[f"mean_{key}"] = round(float(np.mean(values)), 2)
+            line += f"; {key} at the end: mean {np.mean(values):.2f}, max {np.max(values):.2f}"
     if exp.solved_score is not None:
         line += f"; solved threshold {exp.solved_score:g}: {'met' if returns.mean() >= exp.solved_score else 'not met'}"
     return summary, line

@@ -2,11 +2,14 @@
 
 Only the episode-driven configs (``EpisodeLoop``: DQN, A2C, SAC) ask for it; for the others
 (PPO) it is switched off. Every ``eval_every_steps`` env steps the greedy policy plays
-``eval_episodes`` episodes on the fixed selection seeds (never the final evaluation's); the result
-goes to ``evals.csv``; the best one is remembered, with a snapshot of its weights when
-``keep_best`` is set, and ``stop_eval_score`` can end the run once an evaluation reaches it.
+``eval_episodes`` episodes on the fixed selection seeds (never the final evaluation's); the mean,
+the std and the share of episodes that lasted to the time limit go to ``evals.csv``; the best
+mean is remembered, with a snapshot of its weights when ``keep_best`` is set, and
+``stop_eval_score`` can end the run once an evaluation reaches it.
 """
 from __future__ import annotations
+
+import numpy as np
 
 
 class PeriodicEvaluation:
@@ -28,18 +31,20 @@ class PeriodicEvaluation:
 
     def run(self, experiment, greedy_policy, snapshot, env_steps: int) -> dict:
         """Evaluate now; return its numbers for ``evals.csv``. ``snapshot() -> weights``."""
-        from rlcore.evaluation import evaluate
+        from rlcore.evaluation import play_greedy
 
         while self.next_step <= env_steps:
             self.next_step += self.every
-        returns = evaluate(experiment, greedy_policy, self.episodes, seed_base=experiment.selection_seed_base,
-                           max_episode_steps=self.max_episode_steps, progress=False)
+        records = play_greedy(experiment, greedy_policy, self.episodes, seed_base=experiment.selection_seed_base,
+                              max_episode_steps=self.max_episode_steps, progress=False)
+        returns = np.array([r["return"] for r in records])
         mean, std = float(returns.mean()), float(returns.std())
         if self.best is None or mean >= self.best["mean"]:
             self.best = {"mean": round(mean, 2), "std": round(std, 2), "env_steps": env_steps}
             if self.keep_best:
                 self.best_weights = snapshot()
-        return {"eval_mean": mean, "eval_std": std}
+        return {"eval_mean": mean, "eval_std": std,
+                "eval_time_limit_share": float(np.mean([r["time_limit"] for r in records]))}
 
     def reached_stop_score(self) -> bool:
         return bool(self.stop_score) and self.best is not None and self.best["mean"] >= self.stop_score

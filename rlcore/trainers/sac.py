@@ -49,7 +49,7 @@ def train(spec: RunSpec) -> Path:
             obs, _ = env.reset(seed=first_seed)
             agent.observe(obs)
             first_seed = None  # later episodes continue the env's own RNG
-            episode_return, losses = 0.0, []
+            episode_return, episode_steps, losses = 0.0, 0, []
             while True:
                 if session.env_steps < cfg.learning_starts:
                     action = rng.uniform(-1.0, 1.0, act_dim).astype(np.float32)
@@ -60,6 +60,7 @@ def train(spec: RunSpec) -> Path:
                 agent.observe(next_obs)
                 session.env_steps += 1
                 episode_return += reward
+                episode_steps += 1
                 obs = next_obs
                 # len(memory): after a resume without its replay file, the memory refills first
                 if len(memory) >= max(cfg.learning_starts, cfg.batch_size) and session.env_steps % k == 0:
@@ -73,7 +74,8 @@ def train(spec: RunSpec) -> Path:
             if session.stop_requested:  # partial episode: not counted; its transitions stay in replay
                 break
             means = episode_means(losses, ("critic_loss", "actor_loss", "alpha", "entropy", "q_mean"))
-            session.end_episode(episode_return, {"grad_steps": grad_steps, **means})
+            # episode_steps: how long it stood (Minitaur: a fall ends it before the time limit)
+            session.end_episode(episode_return, {"episode_steps": episode_steps, "grad_steps": grad_steps, **means})
             if session.book.episodes % cfg.checkpoint_every == 0:
                 checkpoint()
     env.close()

@@ -3,6 +3,7 @@ import csv
 import json
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from rlcore import experiment as registry
@@ -65,6 +66,9 @@ def test_sac_learns_the_reach_task(tmp_path):
     returns = evaluate(exp, policy, episodes=20, progress=False)
     assert returns.mean() >= -1.0, f"SAC mean-action return {returns.mean():.2f}; random is about -5"
     assert meta["env_steps"] == 2500
+    # each episode's length is logged (Minitaur's falls show there); the run ends with a whole episode
+    steps = pd.read_csv(model_dir / "metrics.csv")["episode_steps"]
+    assert steps.sum() == 2500 and steps.min() >= 1
 
 
 @pytest.mark.parametrize("algo", ["dqn", "a2c", "ppo", "sac"])
@@ -143,7 +147,8 @@ def test_periodic_evaluation_keeps_the_best_weights(algo, tmp_path):
     model_dir = TRAINERS[algo].train(spec)
     meta = json.loads((model_dir / "meta.json").read_text())
     evals = (model_dir / "evals.csv").read_text().splitlines()
-    assert evals[0] == "env_steps,episode,eval_mean,eval_std"
+    assert evals[0] == "env_steps,episode,eval_mean,eval_std,eval_time_limit_share"
+    assert all(line.endswith(",1.0") for line in evals[1:])  # the sign bandit only ends at its time limit
     assert len(evals) - 1 == meta["env_steps"] // 100
     best = max(float(line.split(",")[2]) for line in evals[1:])
     assert meta["weights"] == "best periodic evaluation" and meta["best_eval"]["mean"] == pytest.approx(best)
@@ -254,7 +259,6 @@ def test_a_seed_reproduces_its_run_and_another_seed_does_not(algo, tmp_path):
     """Same seed, same episodes, returns and losses (all but the wall clock); seed 1 differs."""
     import dataclasses
 
-    import pandas as pd
 
     def metrics(name, seed):
         spec = dataclasses.replace(toy.spec(algo, tmp_path / name, **SHORT[algo]), seed=seed)

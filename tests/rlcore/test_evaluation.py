@@ -1,0 +1,63 @@
+"""The greedy evaluation's per-episode records: seed order, lengths, time limit against a fall,
+final info values, and the summary that goes into meta.json."""
+import gymnasium as gym
+import numpy as np
+import pytest
+
+from rlcore.evaluation import evaluate, play_greedy
+from rlcore.experiment import Experiment
+from rlcore.shipping import run_evaluation
+
+LIMIT = 6
+
+
+class FallOrWalk(gym.Env):
+    """Pays 1 per step; x grows 0.5 per step. An even seed s falls (terminates) after 1 + s % 5
+    steps; an odd seed walks until the time limit."""
+    observation_space = gym.spaces.Box(-1.0, 1.0, (1,), np.float32)
+    action_space = gym.spaces.Discrete(2)
+
+    def reset(self, *, seed=None, options=None):
+        super().reset(seed=seed)
+        seed = 1 if seed is None else seed  # the vector env's own auto-reset passes none
+        self.t, self.fall_at = 0, (1 + seed % 5 if seed % 2 == 0 else None)
+        return np.zeros(1, np.float32), {}
+
+    def step(self, action):
+        self.t += 1
+        fell = self.t == self.fall_at
+        return np.zeros(1, np.float32), 1.0, fell, not fell and self.t >= LIMIT, {"x": 0.5 * self.t}
+
+
+def expected(seed):
+    length = 1 + seed % 5 if seed % 2 == 0 else LIMIT
+    return {"seed": seed, "return": float(length), "length": length, "time_limit": seed % 2 == 1,
+            "x": 0.5 * length}
+
+
+EXP = Experiment(name="fall", description="falls on even seeds", make_env=lambda **_: FallOrWalk(),
+                 algos={}, solved_score=5.0, eval_info_keys=("x",))
+ALWAYS_ZERO = lambda obs: np.zeros(len(obs), np.int64)  # noqa: E731
+
+
+def test_each_record_belongs_to_its_seed_also_when_an_env_plays_a_second_episode():
+    # 25 episodes on 20 envs side by side: five envs play a second seed after a short first episode
+    records = play_greedy(EXP, ALWAYS_ZERO, episodes=25, seed_base=100, progress=False, info_keys=("x",))
+    assert records == [expected(s) for s in range(100, 125)]
+    returns = evaluate(EXP, ALWAYS_ZERO, episodes=25, seed_base=100, progress=False)
+    np.testing.assert_array_equal(returns, [r["return"] for r in records])
+
+
+def test_the_summary_counts_the_episodes_that_lasted_to_the_time_limit():
+    class Policy:
+        make_env = staticmethod(FallOrWalk)
+
+        def __call__(self, obs):
+            return ALWAYS_ZERO(obs)
+
+    summary, line = run_evaluation(EXP, Policy(), episodes=4, seed_base=10)
+    # seeds 10, 11, 12, 13: lengths 1, 6, 3, 6
+    assert summary["time_limit_share"] == 0.5 and summary["mean"] == pytest.approx(4.0)
+    assert summary["mean_x"] == pytest.approx(2.0)
+    assert [r["seed"] for r in summary["per_episode"]] == [10, 11, 12, 13]
+    assert "2/4 lasted to the time limit" in line and "x at the end: mean 2.00, max 3.00" in line
