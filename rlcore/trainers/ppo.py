@@ -108,6 +108,8 @@ def train(spec: RunSpec) -> Path:
                     if success_key:
                         won = bool(_final(infos, success_key, i, False))
                         flags += won
+                    for key in exp.episode_info_keys:  # NaN where the env did not report it
+                        extra[key] = float(_final(infos, key, i, float("nan")))
                     session.end_episode(running[i], extra, success=won)
                     running[i] = 0.0
                     ended += 1

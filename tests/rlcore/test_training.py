@@ -1,5 +1,6 @@
 """The real training loops on a tiny env: they learn, checkpoint, resume and write their outputs."""
 import csv
+import dataclasses
 import json
 
 import numpy as np
@@ -338,3 +339,13 @@ def test_a_run_in_progress_becomes_a_model_of_its_last_checkpoint(algo, tmp_path
     for got, want in zip(policy.model.get_weights(), saved):
         np.testing.assert_array_equal(got, want)
     assert sorted(p.name for p in spec.run_dir.iterdir()) == files_before
+
+
+def test_ppo_logs_the_experiments_episode_info_keys(tmp_path):
+    spec = toy.spec("ppo", tmp_path, max_episodes=30, stop_success_share=0.0)
+    spec.experiment = dataclasses.replace(spec.experiment, episode_info_keys=("won", "absent"))
+    ppo_trainer.train(spec)
+    rows = pd.read_csv(spec.run_dir / "metrics.csv")
+    # an episode's final info value (won: 8 of 10 right) beside the trainer's own success column
+    assert len(rows) >= 30 and (rows["won"] == rows["success"]).all() and rows["won"].nunique() == 2
+    assert rows["absent"].isna().all()  # a key the env never reports stays empty
