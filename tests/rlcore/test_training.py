@@ -7,7 +7,6 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from rlcore import experiment as registry
 from rlcore.checkpoint import read_checkpoint_state
 from rlcore.errors import UserError
 from rlcore.evaluation import evaluate
@@ -23,11 +22,7 @@ from tests import toy
 TRAINERS = {"dqn": dqn_trainer, "a2c": a2c_trainer, "ppo": ppo_trainer, "sac": sac_trainer}
 
 
-@pytest.fixture(autouse=True)
-def register_toy(monkeypatch):
-    monkeypatch.setitem(registry.EXPERIMENT_MODULES, "toy", "tests.toy")
-    monkeypatch.setitem(registry.EXPERIMENT_MODULES, "toy_image", "tests.toy_image")
-    monkeypatch.setitem(registry.EXPERIMENT_MODULES, "toy_reach", "tests.toy_reach")
+pytestmark = pytest.mark.usefixtures("toy_experiments")
 
 
 @pytest.mark.parametrize("algo", ["dqn", "a2c"])
@@ -258,9 +253,6 @@ SHORT = {"dqn": {"max_episodes": 20}, "a2c": {"max_episodes": 40}, "ppo": {"max_
 @pytest.mark.parametrize("algo", sorted(TRAINERS))
 def test_a_seed_reproduces_its_run_and_another_seed_does_not(algo, tmp_path):
     """Same seed, same episodes, returns and losses (all but the wall clock); seed 1 differs."""
-    import dataclasses
-
-
     def metrics(name, seed):
         spec = dataclasses.replace(toy.spec(algo, tmp_path / name, **SHORT[algo]), seed=seed)
         TRAINERS[algo].train(spec)
