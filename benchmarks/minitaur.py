@@ -2,17 +2,14 @@
 """Minitaur SAC speed, one JSON line per measurement.
 
   python benchmarks/minitaur.py                  # env alone, act, train step
-  python benchmarks/minitaur.py --train-steps 20000   # also: end-to-end training env steps/s,
-                                                      # updates in line and overlapped, side by side
+  python benchmarks/minitaur.py --train-steps 20000   # also: end-to-end training env steps/s
 
 Measurements:
   env_random   env steps/s of our pybullet Minitaur (5 physics substeps each), random actions
   render       seconds per rgb_array frame (CPU TinyRenderer)
   act          one sampled action: numpy actor forward
   train_step   one SAC gradient step (critics, actor, temperature, targets), alone and K per call
-  train        end-to-end env steps/s of the default preset for N steps, the first 1,000 random,
-               without periodic evaluations; once with the updates on the trainer's thread and once
-               overlapped with the env steps in a worker thread (--overlap-updates)
+  train        end-to-end env steps/s of the default preset for N steps (incl. 10k random ones)
 """
 from __future__ import annotations
 
@@ -86,18 +83,17 @@ def bench_agent():
         emit(bench="train_step", updates_per_call=k, ms_per_call=round(ms, 2), ms_per_update=round(ms / k, 2))
 
 
-def bench_train(steps: int, overlap: bool):
+def bench_train(steps: int):
     from rlcore.trainers import sac
     from rlcore.trainers.spec import RunSpec
 
-    cfg = dataclasses.replace(CFG, max_env_steps=steps, eval_every_steps=0, keep_best=False,
-                              learning_starts=1_000, overlap_updates=overlap)
+    cfg = dataclasses.replace(CFG, max_env_steps=steps, eval_every_steps=0, keep_best=False)
     spec = RunSpec(EXPERIMENT, "sac", "default", cfg, 0, "off", Path(tempfile.mkdtemp(prefix="bench_")),
                    command="benchmark", progress=False)
     with contextlib.redirect_stdout(sys.stderr):
         model_dir = sac.train(spec)
     meta = json.loads((model_dir / "meta.json").read_text())
-    emit(bench="train", overlap_updates=overlap, env_steps=meta["env_steps"], random_steps=cfg.learning_starts,
+    emit(bench="train", env_steps=meta["env_steps"], random_steps=cfg.learning_starts,
          wall_seconds=meta["wall_seconds"], env_steps_per_s=round(meta["env_steps"] / meta["wall_seconds"], 1))
 
 
@@ -109,8 +105,7 @@ def main():
     bench_env(args.seconds)
     bench_agent()
     if args.train_steps:
-        for overlap in (False, True):
-            bench_train(args.train_steps, overlap)
+        bench_train(args.train_steps)
 
 
 if __name__ == "__main__":

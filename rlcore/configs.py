@@ -174,8 +174,6 @@ class SACConfig(EpisodeLoop):
                               NON_NEGATIVE)
     updates_per_call: int = _h(1, "gradient steps batched into one compiled call, taken every this many "
                                   "env steps (one env step per gradient step either way)", COUNT)
-    overlap_updates: bool = _h(False, "run each call of updates in a worker thread while the env steps (acting "
-                                      "then lags one call behind the updates)")
     log_std_min: float = _h(-20.0, "lower clip of the actor's log standard deviation", FINITE)
     log_std_max: float = _h(2.0, "upper clip of the actor's log standard deviation", FINITE)
     obs_norm: bool = _h(False, "standardize observations with the running mean and std of every "

@@ -200,27 +200,11 @@ class SACAgent:
 
     def train_steps(self, obs, action, reward, next_obs, terminated, rng: np.random.Generator) -> dict:
         """``updates_per_call`` gradient steps on stacked minibatches (leading axis K)."""
-        return self.finish_update(self.run_update(self.prepare_update(obs, action, reward, next_obs,
-                                                                      terminated, rng)))
-
-    # The same in three parts, so that the middle one can run in a worker thread while the env
-    # steps (rlcore/trainers/background.py): the first and last touch the RNG, the running
-    # statistics and the acting copy, and stay on the trainer's thread.
-    def prepare_update(self, obs, action, reward, next_obs, terminated, rng: np.random.Generator) -> tuple:
-        """Push the running statistics into the networks and draw the update's Gaussian noise."""
         self._push_obs_stats()
         noise_shape = (*np.shape(action),)
         next_noise = rng.standard_normal(noise_shape).astype(np.float32)
         noise = rng.standard_normal(noise_shape).astype(np.float32)
-        return obs, action, reward, next_obs, terminated, next_noise, noise
-
-    def run_update(self, prepared: tuple):
-        """The compiled gradient steps: (losses, the actor's new weights)."""
-        return self._updates(*prepared)
-
-    def finish_update(self, result) -> dict:
-        """Check the losses and hand the new actor weights to acting."""
-        losses, weights = result
+        losses, weights = self._updates(obs, action, reward, next_obs, terminated, next_noise, noise)
         losses = {k: float(v) for k, v in losses.items()}
         bad = [k for k, v in losses.items() if not math.isfinite(v)]
         if bad:  # XLA drops check_numerics, so the check is here, after the call

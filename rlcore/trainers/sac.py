@@ -14,7 +14,6 @@ import numpy as np
 from rlcore.agents.sac import SACAgent
 from rlcore.replay import ReplayMemory
 from rlcore.trainers import checkpoints
-from rlcore.trainers.background import BackgroundUpdate
 from rlcore.trainers.divergence import reported_divergence
 from rlcore.trainers.episodes import episode_means
 from rlcore.trainers.session import TrainingSession
@@ -36,19 +35,8 @@ def train(spec: RunSpec) -> Path:
         agent.restore_obs_stats(state.get("obs_stats"))
     session = TrainingSession(spec, state, resumed_arrays=arrays)
     grad_steps = int(state["grad_steps"]) if state else 0
-    # with overlap_updates, an update runs in a worker thread while the env steps (background.py)
-    updates = BackgroundUpdate(agent.run_update, cfg.overlap_updates)
-    losses: list[dict] = []  # this episode's update reports
-
-    def settle():
-        """Collect the update in flight: its losses, and its actor for acting."""
-        with reported_divergence(session, "SAC", "lower the learning rates"):
-            result = updates.collect()
-            if result is not None:
-                losses.append(agent.finish_update(result))
 
     def checkpoint():
-        settle()
         checkpoints.save(session, agent, rng, memory, grad_steps=grad_steps,
                          log_alpha=float(agent.log_alpha.numpy()),
                          obs_stats=agent.obs_stats_state())
@@ -56,13 +44,12 @@ def train(spec: RunSpec) -> Path:
     k = cfg.updates_per_call
     # a resumed run reseeds from its episode count
     first_seed = session.fresh_env_seeds(1)[0]
-    with session.interruptible(), updates:
+    with session.interruptible():
         while not session.should_stop():
             obs, _ = env.reset(seed=first_seed)
             agent.observe(obs)
             first_seed = None  # later episodes continue the env's own RNG
-            episode_return, episode_steps = 0.0, 0
-            losses.clear()
+            episode_return, episode_steps, losses = 0.0, 0, []
             while True:
                 if session.env_steps < cfg.learning_starts:
                     action = rng.uniform(-1.0, 1.0, act_dim).astype(np.float32)
@@ -77,12 +64,11 @@ def train(spec: RunSpec) -> Path:
                 obs = next_obs
                 # len(memory): after a resume without its replay file, the memory refills first
                 if len(memory) >= max(cfg.learning_starts, cfg.batch_size) and session.env_steps % k == 0:
-                    settle()
-                    updates.submit(agent.prepare_update(*memory.sample_stacked(k, cfg.batch_size, rng), rng))
+                    stacked = memory.sample_stacked(k, cfg.batch_size, rng)
+                    with reported_divergence(session, "SAC", "lower the learning rates"):
+                        losses.append(agent.train_steps(*stacked, rng))
                     grad_steps += k
-                    if not cfg.overlap_updates:
-                        settle()
-                session.maybe_evaluate(agent.greedy_actions, agent.get_weights, before=settle)
+                session.maybe_evaluate(agent.greedy_actions, agent.get_weights)
                 if terminated or truncated or session.stop_requested:
                     break
             if session.stop_requested:  # partial episode: not counted; its transitions stay in replay
@@ -92,7 +78,6 @@ def train(spec: RunSpec) -> Path:
             session.end_episode(episode_return, {"episode_steps": episode_steps, "grad_steps": grad_steps, **means})
             if session.book.episodes % cfg.checkpoint_every == 0:
                 checkpoint()
-        settle()
     env.close()
     return session.conclude(checkpoint, agent.save, agent.set_weights)
 

@@ -90,15 +90,12 @@ class TrainingSession:
         """One row of rollouts.csv (on-policy trainers: one per update)."""
         self.tracker.log({"rollout": number, "env_steps": self.env_steps, **row}, table="rollouts")
 
-    def maybe_evaluate(self, greedy_policy, snapshot, before=None) -> None:
+    def maybe_evaluate(self, greedy_policy, snapshot) -> None:
         """When due, a periodic greedy evaluation (:class:`PeriodicEvaluation`), logged to evals.csv.
 
-        ``greedy_policy(obs_batch) -> actions``; ``snapshot() -> weights`` of the model now;
-        ``before()``, when given, runs first (SAC collects its update in flight there).
+        ``greedy_policy(obs_batch) -> actions``; ``snapshot() -> weights`` of the model now.
         """
         if self.evaluation.due(self.env_steps):
-            if before is not None:
-                before()
             result = self.evaluation.run(self.spec.experiment, greedy_policy, snapshot, self.env_steps)
             self.tracker.log({"env_steps": self.env_steps, "episode": self.book.episodes, **result},
                              table="evals")
