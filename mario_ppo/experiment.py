@@ -72,6 +72,6 @@ EXPERIMENT = Experiment(
     video_fps=60,
     env_fields=("world", "stage", "actions", "score_reward", "stall_steps", "stall_outcome",
                 "frames", "dead_ends"), success_key="flag_get", progress_key="x_pos",
-    episode_info_keys=("stalled",),
+    info_keys=("stalled",),
     eval_episodes=10, ship_by=("world", "stage"), default_model="1-1", score_label="return (shaped, /10)",
 )

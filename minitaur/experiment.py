@@ -26,5 +26,5 @@ EXPERIMENT = Experiment(
     algos={"sac": AlgoSpec("sac", "sac", "SAC, twin critics", {"article": ARTICLE, "default": DEFAULT})},
     video_fps=60,
     eval_episodes=30, episodes_per_video=3,
-    eval_info_keys=("x",),  # the base's x position at the end: metres walked from the start
+    info_keys=("x",),  # the base's x position at the end: metres walked from the start
 )

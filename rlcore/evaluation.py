@@ -4,6 +4,8 @@ from __future__ import annotations
 import numpy as np
 from tqdm import tqdm
 
+from rlcore.vector import final_info
+
 
 def evaluate(experiment, policy, episodes: int = 100, seed_base: int | None = None,
              max_episode_steps: int | None = None, progress: bool = True, make_env=None) -> np.ndarray:
@@ -46,10 +48,9 @@ def play_greedy(experiment, policy, episodes: int = 100, seed_base: int | None =
         running += reward
         length += 1
         for i in np.flatnonzero((terminated | truncated) & active):
-            final = info.get("final_info", {})
             record = {"seed": slot_seed[i], "return": float(running[i]), "length": int(length[i]),
                       "time_limit": bool(truncated[i] and not terminated[i])}
-            record.update({k: float(final[k][i]) for k in info_keys if k in final})
+            record.update({k: float(final_info(info, k, i, float("nan"))) for k in info_keys})
             records.append(record)
             running[i], length[i] = 0.0, 0
             bar.update(1)
@@ -65,7 +66,7 @@ def play_greedy(experiment, policy, episodes: int = 100, seed_base: int | None =
 
 def evaluate_success(make_env, act, episodes: int, seed_base: int, success_key: str,
                      progress_key: str | None = None, progress: bool = True,
-                     stop_at_success: bool = False) -> list[dict]:
+                     stop_at_success: bool = False, info_keys: tuple[str, ...] = ()) -> list[dict]:
     """Play episodes one by one; episode i resets with seed ``seed_base + i`` and draws its actions
     from ``act(obs_batch, rng)`` with ``rng = default_rng(seed_base + i)``.
 
@@ -88,6 +89,7 @@ def evaluate_success(make_env, act, episodes: int, seed_base: int, success_key: 
                       "success": bool(info.get(success_key, False))}
             if progress_key:
                 record[progress_key] = float(info.get(progress_key, float("nan")))
+            record.update({k: float(info.get(k, float("nan"))) for k in info_keys})
             records.append(record)
             bar.update(1)
             if stop_at_success and record["success"]:

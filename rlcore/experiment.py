@@ -50,11 +50,10 @@ class Experiment:
     # success per episode, evaluation counts successes and plays sampled actions, not greedy ones
     success_key: str | None = None
     progress_key: str | None = None  # an info key that measures progress (Mario: x_pos), logged and plotted
-    # info keys whose final value each training episode logs to metrics.csv (Mario: stalled, 1 when the
-    # stall limit ended it); PPO's trainer logs them
-    episode_info_keys: tuple[str, ...] = ()
-    # info keys whose final value each greedy evaluation episode records (Minitaur: x, metres walked)
-    eval_info_keys: tuple[str, ...] = ()
+    # info keys whose value at an episode's end is kept per episode: in metrics.csv by the PPO and SAC
+    # trainers, and in the evaluation's per-episode records (Mario: stalled, 1 when the stall limit
+    # ended it; Minitaur: x, metres walked)
+    info_keys: tuple[str, ...] = ()
     # config fields that name a shipped model (Mario: world, stage -> saved_networks/mario_ppo/1-1);
     # empty: one model per algorithm, saved_networks/EXPERIMENT/ALGO
     ship_by: tuple[str, ...] = ()

@@ -54,7 +54,7 @@ def run_evaluation(exp, policy, episodes: int, seed_base: int | None) -> tuple[d
         from rlcore.evaluation import evaluate_success, summarize_success
 
         records = evaluate_success(policy.make_env, policy.sample, episodes, seed_base, success_key,
-                                   progress_key)
+                                   progress_key, info_keys=exp.info_keys)
         summary = {**summarize_success(records, progress_key), "seeds": seeds,
                    "policy": "sampled from pi, numpy RNG seeded per episode",
                    "per_episode": records}
@@ -67,7 +67,7 @@ def run_evaluation(exp, policy, episodes: int, seed_base: int | None) -> tuple[d
     from rlcore.evaluation import play_greedy
 
     records = play_greedy(exp, policy, episodes, seed_base, make_env=policy.make_env,
-                          info_keys=exp.eval_info_keys)
+                          info_keys=exp.info_keys)
     returns = np.array([r["return"] for r in records])
     full = sum(r["time_limit"] for r in records)
     summary = {"episodes": episodes, "mean": round(float(returns.mean()), 2),
@@ -76,7 +76,7 @@ def run_evaluation(exp, policy, episodes: int, seed_base: int | None) -> tuple[d
                "per_episode": records}
     line = (f"greedy return {returns.mean():.1f} +- {returns.std():.1f} over {len(returns)} episodes "
             f"(min {returns.min():.1f}, max {returns.max():.1f}); {full}/{episodes} lasted to the time limit")
-    for key in exp.eval_info_keys:
+    for key in exp.info_keys:
         values = [r[key] for r in records if key in r]
         if values:
             summary[f"mean_{key}"] = round(float(np.mean(values)), 2)

@@ -141,3 +141,12 @@ class EnvPool:
 
     def __exit__(self, *exc):
         self.close(terminate=exc[0] is not None)
+
+
+def final_info(infos: dict, key: str, i: int, default=0):
+    """An info value of env ``i`` at the step its episode ended (same-step auto-reset)."""
+    final = infos.get("final_info", {})
+    mask = final.get(f"_{key}")  # Gymnasium marks which envs carry the key
+    if key in final and (mask is None or mask[i]):
+        return final[key][i]
+    return default

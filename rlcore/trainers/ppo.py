@@ -19,16 +19,7 @@ from rlcore.trainers import checkpoints
 from rlcore.trainers.divergence import reported_divergence
 from rlcore.trainers.session import TrainingSession
 from rlcore.trainers.spec import RunSpec
-from rlcore.vector import EnvPool
-
-
-def _final(infos: dict, key: str, i: int, default=0):
-    """An info value of env ``i`` at the step its episode ended (same-step auto-reset)."""
-    final = infos.get("final_info", {})
-    mask = final.get(f"_{key}")  # Gymnasium marks which envs carry the key
-    if key in final and (mask is None or mask[i]):
-        return final[key][i]
-    return default
+from rlcore.vector import EnvPool, final_info
 
 
 class Rollout:
@@ -102,14 +93,14 @@ def train(spec: RunSpec) -> Path:
                 for i in np.flatnonzero(done):
                     extra, won = dict(losses), None
                     if progress_key:
-                        x = float(_final(infos, progress_key, i))
+                        x = float(final_info(infos, progress_key, i))
                         max_x, min_x = max(max_x, x), min(min_x, x)
                         extra[progress_key] = x
                     if success_key:
-                        won = bool(_final(infos, success_key, i, False))
+                        won = bool(final_info(infos, success_key, i, False))
                         flags += won
-                    for key in exp.episode_info_keys:  # NaN where the env did not report it
-                        extra[key] = float(_final(infos, key, i, float("nan")))
+                    for key in exp.info_keys:  # NaN where the env did not report it
+                        extra[key] = float(final_info(infos, key, i, float("nan")))
                     session.end_episode(running[i], extra, success=won)
                     running[i] = 0.0
                     ended += 1

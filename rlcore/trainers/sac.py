@@ -55,7 +55,7 @@ def train(spec: RunSpec) -> Path:
                     action = rng.uniform(-1.0, 1.0, act_dim).astype(np.float32)
                 else:
                     action = agent.act(obs[None], rng)[0]
-                next_obs, reward, terminated, truncated, _ = env.step(action)
+                next_obs, reward, terminated, truncated, info = env.step(action)
                 memory.add(obs, action, reward, next_obs, terminated)
                 agent.observe(next_obs)
                 session.env_steps += 1
@@ -75,7 +75,9 @@ def train(spec: RunSpec) -> Path:
                 break
             means = episode_means(losses, ("critic_loss", "actor_loss", "alpha", "entropy", "q_mean"))
             # episode_steps: how long it stood (Minitaur: a fall ends it before the time limit)
-            session.end_episode(episode_return, {"episode_steps": episode_steps, "grad_steps": grad_steps, **means})
+            ends = {k: float(info.get(k, float("nan"))) for k in spec.experiment.info_keys}
+            session.end_episode(episode_return, {"episode_steps": episode_steps, **ends, "grad_steps": grad_steps,
+                                                 **means})
             if session.book.episodes % cfg.checkpoint_every == 0:
                 checkpoint()
     env.close()

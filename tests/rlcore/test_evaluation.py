@@ -36,7 +36,7 @@ def expected(seed):
 
 
 EXP = Experiment(name="fall", description="falls on even seeds", make_env=lambda **_: FallOrWalk(),
-                 algos={}, solved_score=5.0, eval_info_keys=("x",))
+                 algos={}, solved_score=5.0, info_keys=("x",))
 ALWAYS_ZERO = lambda obs: np.zeros(len(obs), np.int64)  # noqa: E731
 
 

@@ -333,11 +333,19 @@ def test_a_run_in_progress_becomes_a_model_of_its_last_checkpoint(algo, tmp_path
     assert sorted(p.name for p in spec.run_dir.iterdir()) == files_before
 
 
-def test_ppo_logs_the_experiments_episode_info_keys(tmp_path):
+def test_ppo_logs_the_experiments_info_keys(tmp_path):
     spec = toy.spec("ppo", tmp_path, max_episodes=30, stop_success_share=0.0)
-    spec.experiment = dataclasses.replace(spec.experiment, episode_info_keys=("won", "absent"))
+    spec.experiment = dataclasses.replace(spec.experiment, info_keys=("won", "absent"))
     ppo_trainer.train(spec)
     rows = pd.read_csv(spec.run_dir / "metrics.csv")
     # an episode's final info value (won: 8 of 10 right) beside the trainer's own success column
     assert len(rows) >= 30 and (rows["won"] == rows["success"]).all() and rows["won"].nunique() == 2
     assert rows["absent"].isna().all()  # a key the env never reports stays empty
+
+
+def test_sac_logs_the_experiments_info_keys(tmp_path):
+    spec = toy.spec("sac", tmp_path, max_env_steps=300, learning_starts=100)
+    spec.experiment = dataclasses.replace(spec.experiment, info_keys=("absent",))
+    sac_trainer.train(spec)
+    rows = pd.read_csv(spec.run_dir / "metrics.csv")
+    assert len(rows) == 30 and rows["absent"].isna().all()  # declared, not reported by the env: empty
