@@ -24,10 +24,15 @@ AGGREGATES = ("mean", "median", "iqm")
 
 
 def aggregates(scores: np.ndarray) -> np.ndarray:
-    """[mean, median, IQM] of a (runs, tasks) score matrix, as rliable computes them."""
+    """[mean, median, IQM] of a (runs, tasks) score matrix.
+
+    The mean and IQM are rliable's. The median is the median over runs of each run's mean over
+    tasks: rliable's ``aggregate_median`` is the median over *tasks* of the per-task means, which
+    for the single task of a sweep group is just the mean again.
+    """
     from rliable import metrics
 
-    return np.array([metrics.aggregate_mean(scores), metrics.aggregate_median(scores),
+    return np.array([metrics.aggregate_mean(scores), float(np.median(scores.mean(axis=1))),
                      metrics.aggregate_iqm(scores)])
 
 
@@ -80,15 +85,20 @@ def load_runs(sweep_dir: Path) -> list[dict]:
     return rows
 
 
+def run_curve(run_dir: Path) -> tuple[np.ndarray, np.ndarray]:
+    """One run's (env steps, 100-episode average return) at each episode's end, from metrics.csv."""
+    with open(Path(run_dir) / "metrics.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    return (np.array([float(r["env_steps"]) for r in rows]),
+            np.array([float(r["av_latest_points"]) for r in rows]))
+
+
 def learning_curve(run_dirs: list[Path], points: int = 40) -> tuple[np.ndarray, np.ndarray]:
-    """(env steps grid, [runs, points] 100-episode average return), each run interpolated."""
-    curves = []
-    for run_dir in run_dirs:
-        with open(Path(run_dir) / "metrics.csv", newline="") as f:
-            rows = list(csv.DictReader(f))
-        steps = np.array([float(r["env_steps"]) for r in rows])
-        values = np.array([float(r["av_latest_points"]) for r in rows])
-        curves.append((steps, values))
+    """(env steps grid, [runs, points] 100-episode average return), each run interpolated.
+
+    The grid ends where the shortest run ends, so every point aggregates every run.
+    """
+    curves = [run_curve(d) for d in run_dirs]
     end = min(s[-1] for s, _ in curves)
     grid = np.linspace(0, end, points)
     return grid, np.stack([np.interp(grid, s, v) for s, v in curves])
@@ -142,7 +152,10 @@ def markdown(result: dict) -> str:
 
 
 def plot_curves(result: dict, out: Path, reps: int = 1000) -> Path:
-    """IQM of the 100-episode average return over env steps, with its 95 % CI band, per sweep."""
+    """IQM of the 100-episode average return over env steps, with its 95 % CI band, per sweep.
+
+    The band covers the env steps every run reached; each run is also drawn in full, thin.
+    """
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -158,8 +171,10 @@ def plot_curves(result: dict, out: Path, reps: int = 1000) -> Path:
             iqm.append(float(point))
             low.append(float(ci[0]))
             high.append(float(ci[1]))
-        ax.plot(grid, iqm, label=f"{s['label']} (IQM of {len(s['runs'])} runs)")
-        ax.fill_between(grid, low, high, alpha=0.25)
+        line, = ax.plot(grid, iqm, lw=2, label=f"{s['label']}: IQM of {len(s['runs'])} runs, 95% CI")
+        ax.fill_between(grid, low, high, color=line.get_color(), alpha=0.25)
+        for r in s["runs"]:  # each run in full, since runs with an episode budget end at different steps
+            ax.plot(*run_curve(r["run_dir"]), color=line.get_color(), lw=0.7, alpha=0.35)
     ax.set_xlabel("env steps")
     ax.set_ylabel("100-episode average return")
     ax.legend()

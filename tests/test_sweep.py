@@ -139,6 +139,10 @@ def test_bootstrap_ci_on_known_answers():
     np.testing.assert_allclose(point, [50.5, 50.5, 50.5])
     # the mean of 1..100 has standard error 29.01 / 10: the 95% interval is about 50.5 +- 5.7
     assert ci[0][0] == pytest.approx(50.5 - 5.7, abs=0.8) and ci[1][0] == pytest.approx(50.5 + 5.7, abs=0.8)
+    # skewed scores, as a 5-seed sweep gives: the median is the middle run, not the mean again
+    skewed = np.array([[500.0], [137.0], [500.0], [487.0], [278.0]])
+    # the IQM of 5 runs drops one at each end (scipy's trim_mean, as rliable)
+    np.testing.assert_allclose(aggregates(skewed), [380.4, 487.0, (278 + 487 + 500) / 3])
     assert probability_of_improvement(scores + 1000, scores) == 1.0
     assert probability_of_improvement(scores, scores) == pytest.approx(0.5)
 
