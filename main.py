@@ -367,7 +367,8 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
     plot = sub.add_parser("plot", help="write the training plots of a run folder (running, interrupted "
                                        "or finished)",
                           description="Write the training plots of a run folder from its CSV tables: score "
-                                      "per episode, periodic evaluations, Mario's x position and flag share.")
+                                      "per episode, periodic evaluations; for Mario, x position and flag "
+                                      "share, and a map of where episodes ended.")
     plot.add_argument("run_dir", help="a run folder, e.g. runs/mario_ppo__ppo__0__<time>")
     plot.add_argument("--out", default=None, help="folder for the PNGs (default RUN_DIR/plots)")
     return parser

@@ -7,6 +7,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
 from rlcore.atomic import atomic_path  # noqa: E402
@@ -20,7 +21,7 @@ def plot_run(run_dir: str | Path, out_dir: str | Path, experiment, about: dict) 
 
     ``about`` says what the run trained (``algo``, ``preset``, ``seed``, ``config``), as a checkpoint's
     state or a ``meta.json`` does. Reads ``metrics.csv`` (one row per episode) and, when present,
-    ``evals.csv``; experiments with a goal (``progress_key``) also get the progress plot.
+    ``evals.csv``; experiments with a goal (``progress_key``) also get the progress and endings plots.
     """
     missing = [key for key in ABOUT_KEYS if key not in about]
     if missing:
@@ -37,6 +38,8 @@ def plot_run(run_dir: str | Path, out_dir: str | Path, experiment, about: dict) 
     if experiment.progress_key:
         out.append(plot_progress(metrics, out_dir / f"{prefix}_Progress_{algo}.png", title,
                                  experiment.progress_key, window))
+        out.append(plot_endings(metrics, out_dir / f"{prefix}_Endings_{algo}.png", title,
+                                experiment.progress_key))
     if evals.exists():
         out.append(plot_evaluations(evals, out_dir / f"{prefix}_Eval_{algo}.png", title,
                                     experiment.solved_score, label))
@@ -99,6 +102,52 @@ def plot_progress(csv_path: str | Path, png_path: str | Path, title: str, progre
         share.set_ylabel("success share, %")
         share.legend(loc="upper left")
     return _save(fig, ax, title, png_path)
+
+
+def ending_shares(progress: np.ndarray, block: int, bins: int = 40) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Where episodes ended, over training: episodes in blocks of ``block``, ``progress`` (one value
+    per episode, e.g. Mario's x at the end) cut into ``bins`` equal bins from 0 to its maximum.
+
+    Returns (first episode of each block, bin edges, [bins, blocks] share of the block's episodes
+    that ended in each bin; each column sums to 1).
+    """
+    progress = np.asarray(progress, dtype=float)
+    edges = np.linspace(0.0, max(float(np.nanmax(progress)), 1.0), bins + 1)
+    starts = np.arange(0, len(progress), block)
+    shares = np.zeros((bins, len(starts)))
+    for j, start in enumerate(starts):
+        counts, _ = np.histogram(progress[start:start + block], bins=edges)
+        shares[:, j] = counts / max(counts.sum(), 1)
+    return starts + 1, edges, shares
+
+
+def plot_endings(csv_path: str | Path, png_path: str | Path, title: str, progress_key: str,
+                 blocks: int = 60) -> Path:
+    """A map of where episodes ended (``progress_key``, e.g. Mario's x) over training: the dark rows
+    are where the agent keeps dying or stalling. Episodes with a ``stalled`` mark add its share."""
+    df = _table(csv_path, "episode", progress_key)
+    block = max(1, int(np.ceil(len(df) / blocks)))
+    starts, edges, shares = ending_shares(df[progress_key].to_numpy(), block)
+    fig, ax = plt.subplots(figsize=(9, 5))
+    image = ax.imshow(shares, origin="lower", aspect="auto", cmap="magma_r", interpolation="nearest",
+                      extent=(starts[0], starts[-1] + block, edges[0], edges[-1]))
+    fig.colorbar(image, ax=ax, pad=0.09, label=f"share of the {block} episodes of a column")
+    ax.set_xlabel("episode")
+    ax.set_ylabel(f"{progress_key} at the episode's end")
+    if "stalled" in df and df["stalled"].notna().any():
+        stalled = df["stalled"].groupby(np.arange(len(df)) // block).mean()
+        share = ax.twinx()
+        share.plot(starts + block / 2, 100 * stalled.to_numpy(), color="tab:cyan", linewidth=1.5,
+                   label="ended by the stall limit, %")
+        share.set_ylim(0, 100)
+        share.set_ylabel("stalled, %")
+        share.legend(loc="upper left")
+    ax.set_title(title)
+    fig.tight_layout()
+    with atomic_path(png_path) as tmp:
+        fig.savefig(tmp, dpi=100)
+    plt.close(fig)
+    return Path(png_path)
 
 
 def _table(csv_path: str | Path, *columns: str) -> pd.DataFrame:

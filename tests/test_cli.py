@@ -5,6 +5,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import main
@@ -159,8 +160,21 @@ def test_plot_of_an_unfinished_mario_run(capsys, tmp_path):
     code, out, err = run(capsys, "plot", str(tmp_path))
     assert code == 0, err
     written = [line.split()[-1] for line in out.splitlines()]
-    assert [Path(p).name for p in written] == ["mario_ppo_Train_ppo.png", "mario_ppo_Progress_ppo.png"]
+    assert [Path(p).name for p in written] == ["mario_ppo_Train_ppo.png", "mario_ppo_Progress_ppo.png",
+                                              "mario_ppo_Endings_ppo.png"]
     assert all(Path(p).stat().st_size > 1000 for p in written)
+
+
+def test_ending_shares_say_where_each_block_of_episodes_ended():
+    from rlcore.plotting import ending_shares
+
+    # 10 episodes end at x 100, then 10 at x 900 (the farthest any got), then 5 split 450 / 900
+    x = [100.0] * 10 + [900.0] * 10 + [450.0, 900.0, 450.0, 900.0, 450.0]
+    starts, edges, shares = ending_shares(x, block=10, bins=9)
+    assert starts.tolist() == [1, 11, 21] and edges[0] == 0 and edges[-1] == 900
+    np.testing.assert_allclose(shares.sum(axis=0), 1.0)
+    assert shares[1, 0] == 1.0 and shares[8, 1] == 1.0  # x 100 in bin [100, 200), x 900 in the last bin
+    assert shares[4, 2] == pytest.approx(0.6) and shares[8, 2] == pytest.approx(0.4)
 
 
 @pytest.mark.parametrize("signal_name", ["SIGINT", "SIGTERM"])
