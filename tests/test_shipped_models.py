@@ -2,6 +2,7 @@
 from pathlib import Path
 
 import imageio.v3 as iio
+import numpy as np
 import pytest
 
 from rlcore.evaluation import evaluate
@@ -49,9 +50,15 @@ def test_shipped_model_meets_its_bar(experiment, algo):
         assert key in meta, key
     assert meta["evaluation"]["episodes"] == exp.eval_episodes
     assert meta["evaluation"]["mean"] >= bar
-    # and it still plays: seeded episodes from the unseen-seed range
+    # and it still plays: seeded episodes from the unseen-seed range, each as its record says
     returns = evaluate(exp, policy, episodes=EPISODES.get(experiment, 5), progress=False)
     assert returns.mean() >= bar, f"{experiment} {algo}: {returns.round(1)}"
+    recorded = meta["evaluation"]["per_episode"]
+    assert len(recorded) == exp.eval_episodes
+    assert np.mean([r["return"] for r in recorded]) == pytest.approx(meta["evaluation"]["mean"], abs=0.01)
+    assert [r["seed"] for r in recorded[:len(returns)]] == list(range(exp.eval_seed_base,
+                                                                        exp.eval_seed_base + len(returns)))
+    np.testing.assert_allclose(returns, [r["return"] for r in recorded[:len(returns)]], rtol=1e-5)
 
 
 @pytest.mark.parametrize("experiment, algo, folder", sorted(SUCCESS_BARS))
@@ -65,6 +72,12 @@ def test_shipped_model_reaches_its_goal(experiment, algo, folder):
     records = evaluate_success(policy.make_env, policy.sample, 3, exp.eval_seed_base, key,
                                exp.progress_key, progress=False, stop_at_success=True)
     assert any(r["success"] for r in records), records
+    # each episode replays its record (seeded env and seeded action draws)
+    recorded = meta["evaluation"]["per_episode"]
+    assert np.mean([r["success"] for r in recorded]) == pytest.approx(meta["evaluation"]["success_share"])
+    for got, want in zip(records, recorded):
+        assert (got["seed"], got["success"], got["length"]) == (want["seed"], want["success"], want["length"])
+        assert got[exp.progress_key] == want[exp.progress_key]
 
 
 def test_render_of_a_shipped_model_is_a_decodable_mp4(tmp_path):

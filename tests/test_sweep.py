@@ -133,7 +133,8 @@ def test_no_ray_process_is_left_behind(local_ray):
 def test_bootstrap_ci_on_known_answers():
     constant = np.full((8, 1), 3.0)
     point, ci = stratified_bootstrap_ci(aggregates, constant, reps=200)
-    np.testing.assert_allclose(point, 3.0) and np.testing.assert_allclose(ci, 3.0)
+    np.testing.assert_allclose(point, 3.0)
+    np.testing.assert_allclose(ci, 3.0)
     scores = np.arange(1.0, 101.0)[:, None]
     point, ci = stratified_bootstrap_ci(aggregates, scores, reps=2000)
     np.testing.assert_allclose(point, [50.5, 50.5, 50.5])
@@ -174,7 +175,8 @@ def test_bad_sweep_values_are_one_line_and_exit_2(capsys, tmp_path, monkeypatch,
 def test_report_groups_a_grid_sweep_by_setting(tmp_path):
     from rlcore.report import markdown
 
-    for lr, scores in (("0.001", (1.0, 2.0, 3.0)), ("0.01", (7.0, 8.0, 9.0))):
+    # skewed scores, so mean, median and IQM differ and a mix-up of their names would show
+    for lr, scores in (("0.001", (137.0, 278.0, 487.0, 500.0, 500.0)), ("0.01", (600.0, 601.0, 650.0))):
         for seed, score in enumerate(scores):
             model = tmp_path / "grid" / f"lr={lr}__seed={seed}" / "model"
             model.mkdir(parents=True)
@@ -184,6 +186,12 @@ def test_report_groups_a_grid_sweep_by_setting(tmp_path):
     result = summarize([tmp_path / "grid"], reps=200)
     labels = [g["label"] for g in result["sweeps"]]
     assert labels == ["grid [lr=0.001]", "grid [lr=0.01]"]
-    assert [g["aggregates"]["mean"][0] for g in result["sweeps"]] == [2.0, 8.0]
+    first = result["sweeps"][0]["aggregates"]
+    assert [first[k][0] for k in ("mean", "median", "iqm")] == pytest.approx([380.4, 487.0, 1265 / 3])
+    assert all(lo <= point <= hi and lo < hi for point, lo, hi in first.values())
+    assert result["sweeps"][1]["aggregates"]["median"][0] == 601.0
     assert result["probability_of_improvement"][0] == 0.0  # every lr=0.001 run below every lr=0.01 run
-    assert "P(grid [lr=0.001] > grid [lr=0.01]) = 0.000" in markdown(result)
+    text = markdown(result)
+    assert "P(grid [lr=0.001] > grid [lr=0.01]) = 0.000" in text
+    lo, hi = first["median"][1:]
+    assert f"| median | 487.000 | [{lo:.3f}, {hi:.3f}] |" in text and "| mean | 380.400 |" in text

@@ -79,8 +79,13 @@ def test_numpy_actor_matches_keras():
 
 def test_sampling_follows_the_policy():
     agent = A2CAgent(OBS, ACTIONS, A2CConfig(actor_hidden=(8,)))
+    weights = agent.actor.model.get_weights()  # a skewed policy: a uniform or mis-ordered draw would show
+    weights[-1] = np.log(np.array([0.55, 0.3, 0.1, 0.05][:ACTIONS], np.float32))
+    agent.actor.model.set_weights(weights)
+    agent.sync_policy_weights()
     obs = np.zeros((20000, OBS), np.float32)
     probs = agent.probs(obs[:1])[0]
+    assert probs.max() > 0.5
     counts = np.bincount(agent.act(obs, np.random.default_rng(0)), minlength=ACTIONS) / len(obs)
     np.testing.assert_allclose(counts, probs, atol=0.015)
 
@@ -99,3 +104,36 @@ def test_update_moves_the_taken_action_towards_positive_advantage():
     assert agent.probs(obs[0, :1])[0, 2] > before + 0.05
     assert set(losses) == {"actor_loss", "critic_loss", "entropy"}
     assert agent._update.experimental_get_tracing_count() == 1
+
+
+@pytest.mark.parametrize("normalize", [False, True])
+def test_update_losses_match_numpy_on_a_rollout_with_truncations(normalize):
+    """The whole wiring of one update: rewards scaled, GAE with bootstraps on truncation only
+    (terminated and dones not swapped), td targets before the advantage is standardized."""
+    cfg = A2CConfig(n_steps=T, num_envs=N, actor_hidden=(16,), critic_hidden=(16,), reward_scale=0.1,
+                    gamma=0.9, gae_lambda=0.7, entropy_coef=0.05, normalize_advantage=normalize)
+    tf.keras.utils.set_random_seed(0)
+    agent = A2CAgent(OBS, ACTIONS, cfg)
+    rng = np.random.default_rng(6)
+    obs, next_obs = (rng.normal(size=(T, N, OBS)).astype(np.float32) for _ in range(2))
+    actions = rng.integers(0, ACTIONS, (T, N)).astype(np.int32)
+    rewards = rng.normal(scale=20.0, size=(T, N)).astype(np.float32)
+    _, _, _, terminated, dones = rollout(seed=2)
+    assert (dones > terminated).any() and terminated.any()
+    actor_w, critic_w = agent.actor.model.get_weights(), agent.critic.model.get_weights()
+
+    values = ref.mlp(critic_w, obs.reshape(-1, OBS))[:, 0].reshape(T, N)
+    next_values = ref.mlp(critic_w, next_obs.reshape(-1, OBS))[:, 0].reshape(T, N)
+    adv = ref.gae(rewards * 0.1, values, next_values, terminated, dones, 0.9, 0.7)
+    td_targets = adv + values
+    want_critic = np.mean((td_targets - values) ** 2)
+    adv = adv.ravel()
+    if normalize:
+        adv = (adv - adv.mean()) / (adv.std() + 1e-8)
+    probs = ref.actor_probs(actor_w, obs.reshape(-1, OBS))
+    total, want_entropy = ref.actor_loss(probs, actions.ravel(), adv, 0.05)
+
+    got = agent.update(obs, actions, rewards, next_obs, terminated, dones)
+    assert got["critic_loss"] == pytest.approx(want_critic, rel=1e-4)
+    assert got["entropy"] == pytest.approx(want_entropy, rel=1e-5)
+    assert got["actor_loss"] == pytest.approx(total + 0.05 * want_entropy, rel=1e-4, abs=1e-5)

@@ -85,19 +85,21 @@ def test_update_with_constant_weights_matches_hand_computed_loss():
     agent.q_network.set_weights(weights)
     agent.target_network.set_weights(weights)
     obs = np.ones((2, OBS), np.float32)
-    action = np.array([0, 1], np.int32)
+    action = np.array([0, 0], np.int32)
     reward = np.array([1.0, 0.0], np.float32)
     terminated = np.array([0.0, 1.0], np.float32)
-    # targets: 1 + 0.5 * max(1, 3) = 2.5 and 0 (terminated); Q taken: 1 and 3
-    # loss = mean((2.5 - 1)^2, (0 - 3)^2) = (2.25 + 9) / 2 = 5.625
+    # targets: 1 + 0.5 * max(1, 3) = 2.5 and 0 (terminated); Q taken: 1 and 1 (all Q: mean 2)
+    # loss = mean((2.5 - 1)^2, (0 - 1)^2) = (2.25 + 1) / 2 = 1.625
     losses = agent.train_step(obs, action, reward, obs, terminated)
-    assert losses["loss"] == pytest.approx(5.625, rel=1e-5)
-    assert losses["q_mean"] == pytest.approx(2.0, rel=1e-5)
-    # Adam's first step moves every bias with a non-zero gradient by lr; target moves tau of the way
+    assert losses["loss"] == pytest.approx(1.625, rel=1e-5)
+    assert losses["q_mean"] == pytest.approx(1.0, rel=1e-5)  # of the actions taken, not of every Q
+    # Adam's first step moves a bias with a non-zero gradient by lr (d loss / d b0 = -0.5 < 0: up);
+    # action 1 was not taken, so its bias stays. The target moves tau of the way.
     new_bias = agent.q_network.get_weights()[-1]
-    np.testing.assert_allclose(new_bias, bias + np.array([1e-3, -1e-3]), rtol=1e-4)
+    np.testing.assert_allclose(new_bias, bias + np.array([1e-3, 0.0]), rtol=0, atol=1e-6)
     target_bias = agent.target_network.get_weights()[-1]
-    np.testing.assert_allclose(target_bias, 0.9 * bias + 0.1 * new_bias, rtol=1e-5)
+    np.testing.assert_allclose(target_bias, 0.9 * bias + 0.1 * new_bias, rtol=0, atol=1e-7)
+    assert abs(target_bias[0] - bias[0]) > 5e-5  # and that move is larger than the tolerance
     np.testing.assert_allclose(agent.policy.weights[-1], new_bias)  # acting sees the update
 
 

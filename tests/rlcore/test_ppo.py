@@ -72,11 +72,12 @@ def _rollout(rng, cfg=CFG):
             (rng.random((t, n)) < 0.1).astype(np.float32), (rng.random((t, n)) < 0.15).astype(np.float32))
 
 
-@pytest.mark.parametrize("target_kl", [0.0, 0.0005])
-def test_compiled_update_equals_an_eager_minibatch_loop(target_kl):
+@pytest.mark.parametrize("target_kl,max_grad_norm", [(0.0, 0.0), (0.0005, 0.0), (0.0, 0.05)])
+def test_compiled_update_equals_an_eager_minibatch_loop(target_kl, max_grad_norm):
     """The one-call update does exactly: targets once, then epochs x shuffled minibatches of Adam,
-    stopping (with target_kl) before the first step whose minibatch KL passes 1.5 x target_kl."""
-    cfg = dataclasses.replace(CFG, target_kl=target_kl)
+    stopping (with target_kl) before the first step whose minibatch KL passes 1.5 x target_kl, and
+    (with max_grad_norm) scaling each minibatch's gradients down to that global norm."""
+    cfg = dataclasses.replace(CFG, target_kl=target_kl, max_grad_norm=max_grad_norm)
     tf.keras.utils.set_random_seed(3)
     agent = PPOAgent(OBS, 5, cfg)
     twin = PPOAgent(OBS, 5, cfg)
@@ -93,7 +94,7 @@ def test_compiled_update_equals_an_eager_minibatch_loop(target_kl):
     rng = np.random.default_rng(5)
     perms = [rng.permutation(size) for _ in range(cfg.epochs)]
     steps = [perm[k * cfg.minibatch:(k + 1) * cfg.minibatch] for perm in perms for k in range(size // cfg.minibatch)]
-    taken, kls = 0, []
+    taken, kls, norms = 0, [], []
     for idx in steps:
         o, a, lp, ad, tg = (x[idx] for x in flat)
         with tf.GradientTape() as tape:
@@ -103,7 +104,10 @@ def test_compiled_update_equals_an_eager_minibatch_loop(target_kl):
         kls.append(ref.approx_kl(logp_new, lp))
         if target_kl and kls[-1] > 1.5 * target_kl:
             break
-        grads = tape.gradient(loss, twin.model.trainable_variables)
+        grads = [g.numpy() for g in tape.gradient(loss, twin.model.trainable_variables)]
+        norms.append(np.sqrt(sum(float(np.sum(g.astype(np.float64) ** 2)) for g in grads)))
+        if max_grad_norm and norms[-1] > max_grad_norm:
+            grads = [g * (max_grad_norm / norms[-1]) for g in grads]
         twin.opt.apply_gradients(zip(grads, twin.model.trainable_variables))
         taken += 1
     for got, want in zip(agent.model.get_weights(), twin.model.get_weights()):
@@ -111,6 +115,8 @@ def test_compiled_update_equals_an_eager_minibatch_loop(target_kl):
     assert int(agent.opt.iterations) == taken
     assert report["update_fraction"] == pytest.approx(taken / len(steps))
     assert report["approx_kl"] == pytest.approx(np.mean(kls), rel=1e-3)  # the stopping minibatch's KL counts
+    if max_grad_norm:  # the clip acted on most steps, so it is what the comparison tests
+        assert np.mean(np.array(norms) > max_grad_norm) > 0.5, norms
     if target_kl:  # the guard stopped this update part-way
         assert 0 < taken < len(steps)
     else:
@@ -136,8 +142,13 @@ def test_update_raises_the_probability_of_advantaged_actions():
 def test_sampling_follows_pi_and_logp_is_its_log():
     tf.keras.utils.set_random_seed(0)
     agent = PPOAgent(OBS, 5, CFG)
+    weights = agent.model.get_weights()  # a skewed policy: a uniform or mis-ordered draw would show
+    head = next(i for i, w in enumerate(weights) if w.shape == (5,))  # the policy head's bias
+    weights[head] = np.log(np.array([0.05, 0.5, 0.1, 0.3, 0.05], np.float32))
+    agent.model.set_weights(weights)
     obs = np.random.default_rng(0).integers(0, 256, (1, *OBS), dtype=np.uint8)
     probs, _ = agent.policy_and_values(obs)
+    assert probs[0].max() > 0.4
     batch = np.repeat(obs, 4000, axis=0)
     actions, logp, values = agent.act(batch, np.random.default_rng(1))
     freq = np.bincount(actions, minlength=5) / len(actions)

@@ -52,6 +52,10 @@ def _batch(rng, n=32):
 def test_one_update_matches_numpy_step_by_step():
     tf.keras.utils.set_random_seed(0)
     agent = SACAgent(OBS, ACT, CFG)
+    perturb = np.random.default_rng(5)  # targets start as copies of the critics: make them differ,
+    for target in agent.targets:        # so a target computed from the online critics would show
+        target.set_weights([w + perturb.normal(scale=0.5, size=w.shape).astype(np.float32)
+                            for w in target.get_weights()])
     obs, action, reward, next_obs, terminated = _batch(np.random.default_rng(1))
     actor_w = agent.actor.get_weights()
     target_ws = [t.get_weights() for t in agent.targets]

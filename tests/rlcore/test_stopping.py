@@ -22,6 +22,8 @@ def test_each_rule_names_itself():
     assert _reason(cfg, best_eval={"mean": 49.9}) is None
     assert _reason(cfg, returns=[9, 11]) == "stop_score 10.0"  # mean of the last 2 is 10
     assert _reason(cfg, returns=[11]) is None  # the window is not full yet
+    assert _reason(cfg, returns=[0, 0, 9, 11]) == "stop_score 10.0"  # only the last 2 count
+    assert _reason(cfg, returns=[20, 8, 11]) is None  # nor the last return alone
 
 
 def test_success_share_needs_a_full_window():
@@ -29,6 +31,9 @@ def test_success_share_needs_a_full_window():
     assert _reason(cfg, returns=[0] * 3, successes=[True] * 3) is None
     assert _reason(cfg, returns=[0] * 4, successes=[True, False, True, True]) == "stop_success_share 0.75"
     assert _reason(cfg, returns=[0] * 4, successes=[True, False, False, True]) is None
+    late = [False, False, True, False, True, True]  # 3 of the last 4; 3 of all 6 would be 0.5
+    assert _reason(cfg, returns=[0] * 6, successes=late) == "stop_success_share 0.75"
+    assert _reason(cfg, returns=[0] * 6, successes=[True] * 3 + [False, True, False]) is None
     assert _reason(dataclasses.replace(cfg, stop_success_share=0.0), returns=[0] * 4, successes=[True] * 4) is None
 
 

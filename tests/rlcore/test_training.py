@@ -53,7 +53,12 @@ def test_ppo_learns_the_picture_task_and_stops_on_the_success_share(tmp_path):
     exp, _, policy = load_policy(model_dir)
     records = evaluate_success(policy.make_env, policy.sample, 10, 10_000, "won", "score", progress=False)
     assert summarize_success(records, "score")["success_share"] >= 0.8
-    assert (policy(np.asarray([policy.make_env().reset(seed=1)[0]])) >= 0).all()
+    env = policy.make_env().unwrapped  # the greedy action is right for both pictures: 1 when s > 0
+    pictures = []
+    for sign in (-1.0, 1.0):
+        env.sign = sign
+        pictures.append(env._obs())
+    assert policy(np.asarray(pictures)).tolist() == [0, 1]
 
 
 def test_sac_learns_the_reach_task(tmp_path):
@@ -68,7 +73,7 @@ def test_sac_learns_the_reach_task(tmp_path):
 
 
 @pytest.mark.parametrize("algo", ["dqn", "a2c", "ppo", "sac"])
-def test_interrupt_then_resume_continues_the_counters(algo, tmp_path):
+def test_interrupt_then_resume_continues_the_counters(algo, tmp_path, monkeypatch):
     extra = {"ppo": {"stop_success_share": 0.0}, "sac": {"max_env_steps": 0, "learning_starts": 100}}
     spec = toy.spec(algo, tmp_path, stop_score=99.0, max_episodes=30, **extra.get(algo, {}))
     _interrupt_after(12, TRAINERS[algo], spec)
@@ -77,13 +82,46 @@ def test_interrupt_then_resume_continues_the_counters(algo, tmp_path):
     # A crash after the checkpoint leaves rows the checkpoint does not know; resume must drop them.
     _append_rows_after_checkpoint(spec.run_dir / "metrics.csv", count=2)
     spec.resume, spec.command = True, "pytest --resume"
+    seen_alpha = _watch_sac_temperature(monkeypatch) if algo == "sac" else []
     model_dir = TRAINERS[algo].train(spec)
+    if algo == "sac":  # the first update after the resume starts from the checkpointed temperature
+        assert seen_alpha[0] == pytest.approx(state["log_alpha"], abs=1e-7)
     meta = json.loads((model_dir / "meta.json").read_text())
     assert meta["command"] == "pytest" and meta["commands"] == ["pytest", "pytest --resume"]
     assert meta["episodes"] >= 30
     assert meta["env_steps"] > state["env_steps"]
     episodes = [int(line.split(",")[0]) for line in (model_dir / "metrics.csv").read_text().splitlines()[1:]]
     assert episodes == list(range(1, len(episodes) + 1)), "episode counter restarted or skipped"
+    _assert_no_jump_at_the_resume(pd.read_csv(model_dir / "metrics.csv"), len(state["returns"]), algo)
+
+
+def _watch_sac_temperature(monkeypatch) -> list[float]:
+    """log_alpha as each SAC update call finds it, in call order."""
+    from rlcore.agents.sac import SACAgent
+
+    seen, train_steps = [], SACAgent.train_steps
+
+    def watched(self, *args, **kwargs):
+        seen.append(float(self.log_alpha.numpy()))
+        return train_steps(self, *args, **kwargs)
+    monkeypatch.setattr(SACAgent, "train_steps", watched)
+    return seen
+
+
+def _assert_no_jump_at_the_resume(df, resumed_at, algo):
+    """The first episode after the resume continues the trainer's own state (toy episodes all have
+    the same length): DQN's epsilon keeps its per-episode decay and its gradient steps their pace;
+    SAC's gradient steps keep their pace and its temperature moves no more than in the steps before."""
+    last, first = resumed_at - 1, resumed_at  # row indices: last checkpointed episode, first resumed
+    if "grad_steps" in df:
+        g = df["grad_steps"].to_numpy()
+        assert g[first] - g[last] == g[last] - g[last - 1] > 0, g[last - 1:first + 1]
+    if algo == "dqn":
+        e = df["epsilon"].to_numpy()
+        assert e[first] / e[last] == pytest.approx(e[last] / e[last - 1], rel=1e-6) and e[first] < e[last]
+    if algo == "sac":
+        step = np.abs(np.diff(np.log(df["alpha"].to_numpy()[last - 3:first + 1])))
+        assert step[-1] <= 2 * np.nanmax(step[:-1]), step  # alpha is empty (NaN) before learning starts
 
 
 def _interrupt_after(episodes, trainer, spec):
@@ -152,6 +190,40 @@ def test_periodic_evaluation_keeps_the_best_weights(algo, tmp_path):
     exp, _, policy = load_policy(model_dir)
     again = evaluate(exp, policy, 4, seed_base=exp.selection_seed_base, max_episode_steps=10, progress=False)
     assert again.mean() == pytest.approx(best)
+
+
+@pytest.mark.parametrize("algo", ["dqn", "a2c"])
+def test_keep_best_saves_the_weights_of_the_best_evaluation_not_the_last(algo, tmp_path, monkeypatch):
+    """Evaluations scripted to fall after the first: the saved model must be the first one's weights,
+    although training went on and changed them."""
+    from rlcore.models import load_keras_model
+    from rlcore.trainers.periodic_eval import PeriodicEvaluation
+
+    scores, snapshots, run = iter(range(100, 0, -1)), [], PeriodicEvaluation.run
+
+    def scripted_play(experiment, policy, episodes, **kwargs):
+        mean = float(next(scores))
+        return [{"seed": i, "return": mean, "length": 10, "time_limit": True} for i in range(episodes)]
+
+    def recording_run(self, experiment, greedy_policy, snapshot, env_steps):
+        def recorded():
+            snapshots.append([w.copy() for w in snapshot()])
+            return snapshots[-1]
+        return run(self, experiment, greedy_policy, recorded, env_steps)
+    monkeypatch.setattr("rlcore.evaluation.play_greedy", scripted_play)
+    monkeypatch.setattr(PeriodicEvaluation, "run", recording_run)
+    spec = toy.spec(algo, tmp_path, eval_every_steps=100, eval_episodes=2, keep_best=True, stop_score=99.0,
+                    max_episodes=40)
+    model_dir = TRAINERS[algo].train(spec)
+    meta = json.loads((model_dir / "meta.json").read_text())
+    assert meta["best_eval"]["mean"] == 100.0 and meta["best_eval"]["env_steps"] == 100
+    assert len(snapshots) == 1  # only the first evaluation was a best
+    saved = [w for path in sorted(model_dir.glob("*.h5")) for w in load_keras_model(path).get_weights()]
+    assert len(saved) == len(snapshots[0])
+    for got, want in zip(saved, snapshots[0]):
+        np.testing.assert_array_equal(got, want)
+    last = pd.read_csv(model_dir / "evals.csv")
+    assert len(last) == 4 and last["eval_mean"].tolist() == [100.0, 99.0, 98.0, 97.0]
 
 
 def test_training_stops_when_an_evaluation_reaches_the_stop_eval_score(tmp_path):
