@@ -72,6 +72,58 @@ def test_sac_learns_the_reach_task(tmp_path):
     assert steps.sum() == 2500 and steps.min() >= 1
 
 
+@pytest.mark.parametrize("ending", ["time limit", "termination"])
+@pytest.mark.parametrize("algo", ["dqn", "sac"])
+def test_replay_marks_terminations_only_so_a_time_limit_still_bootstraps(algo, ending, tmp_path, monkeypatch):
+    """The toy envs end every 10 steps by their time limit; made to end by termination instead,
+    the replay must store terminated = 1 at exactly those steps, and 0 everywhere else."""
+    from rlcore.replay import ReplayMemory
+
+    env_class = {"dqn": toy.SignEnv, "sac": toy.ReachEnv}[algo]
+    step, add, stored = env_class.step, ReplayMemory.add, []
+    if ending == "termination":
+        def terminating_step(self, action):
+            obs, reward, terminated, truncated, info = step(self, action)
+            return obs, reward, terminated or truncated, False, info
+        monkeypatch.setattr(env_class, "step", terminating_step)
+
+    def recording_add(self, obs, action, reward, next_obs, terminated):
+        stored.append(float(terminated))
+        return add(self, obs, action, reward, next_obs, terminated)
+    monkeypatch.setattr(ReplayMemory, "add", recording_add)
+    extra = {"sac": {"max_env_steps": 0, "learning_starts": 20}}.get(algo, {})
+    TRAINERS[algo].train(toy.spec(algo, tmp_path, stop_score=99.0, max_episodes=5, **extra))
+    assert len(stored) == 50
+    want = [float(ending == "termination" and (i + 1) % 10 == 0) for i in range(50)]
+    assert stored == want
+
+
+@pytest.mark.parametrize("ending", ["time limit", "termination"])
+def test_a2c_rollouts_mark_terminations_apart_from_episode_ends(ending, tmp_path, monkeypatch):
+    """What A2C's update gets: ``dones`` at every episode end, ``terminated`` only at terminations
+    (a time limit bootstraps); swapped, the GAE would bootstrap through real ends."""
+    from rlcore.agents.a2c import A2CAgent
+
+    step, update, seen = toy.SignEnv.step, A2CAgent.update, []
+    if ending == "termination":
+        def terminating_step(self, action):
+            obs, reward, terminated, truncated, info = step(self, action)
+            return obs, reward, terminated or truncated, False, info
+        monkeypatch.setattr(toy.SignEnv, "step", terminating_step)
+
+    def recording_update(self, obs, actions, rewards, next_obs, terminated, dones):
+        seen.append((terminated.copy(), dones.copy()))
+        return update(self, obs, actions, rewards, next_obs, terminated, dones)
+    monkeypatch.setattr(A2CAgent, "update", recording_update)
+    spec = toy.spec("a2c", tmp_path, stop_score=99.0, max_episodes=8)
+    TRAINERS["a2c"].train(spec)
+    terminated = np.concatenate([t for t, _ in seen])  # [steps, envs], steps counted from the start
+    dones = np.concatenate([d for _, d in seen])
+    ends = ((np.arange(len(dones)) + 1) % 10 == 0)[:, None] & np.ones(dones.shape[1], bool)
+    np.testing.assert_array_equal(dones, ends)
+    np.testing.assert_array_equal(terminated, ends if ending == "termination" else np.zeros_like(ends))
+
+
 @pytest.mark.parametrize("algo", ["dqn", "a2c", "ppo", "sac"])
 def test_interrupt_then_resume_continues_the_counters(algo, tmp_path, monkeypatch):
     extra = {"ppo": {"stop_success_share": 0.0}, "sac": {"max_env_steps": 0, "learning_starts": 100}}
