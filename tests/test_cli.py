@@ -242,13 +242,13 @@ def test_evaluate_a_mario_level_by_world_and_stage(capsys, tmp_path, monkeypatch
     code, out, err = run(capsys, "evaluate", "mario_ppo", "ppo", "--world", "1", "--stage", "1",
                          "--episodes", "1")
     assert code == 0, err
-    assert f"saved_networks/mario_ppo/1-1): flag_get in " in out
+    assert "saved_networks/mario_ppo/1-1): flag_get in " in out
 
 
 def test_evaluate_and_render_a_run_in_progress_and_a_finished_run_folder(capsys, tmp_path, monkeypatch):
     """--model RUN_DIR: a run without a model plays its last checkpoint (and --record is refused);
     a finished run's folder plays its model/."""
-    from tests.rlcore.test_training import _interrupt_after
+    from tests.rlcore.test_resume import _interrupt_after
     from rlcore.trainers import dqn as dqn_trainer
 
     monkeypatch.setitem(registry.EXPERIMENT_MODULES, "toy", "tests.toy")

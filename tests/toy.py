@@ -10,6 +10,9 @@ import numpy as np
 
 from rlcore.configs import A2CConfig, DQNConfig, PPOConfig, SACConfig
 from rlcore.experiment import AlgoSpec, Experiment
+from rlcore.trainers import a2c, dqn, ppo, sac
+
+TRAINERS = {"dqn": dqn, "a2c": a2c, "ppo": ppo, "sac": sac}  # each module's train(spec) runs one run
 
 
 class SignEnv(gym.Env):

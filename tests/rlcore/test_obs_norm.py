@@ -84,7 +84,7 @@ def test_a_standardized_sac_run_learns_and_its_saved_actor_standardizes(tmp_path
 def test_a_standardized_run_resumes_with_its_statistics(tmp_path):
     from rlcore.checkpoint import read_checkpoint_state
     from rlcore.trainers import sac as sac_trainer
-    from tests.rlcore.test_training import _interrupt_after
+    from tests.rlcore.test_resume import _interrupt_after
 
     spec = toy.spec("sac", tmp_path, obs_norm=True, max_env_steps=0, learning_starts=100, max_episodes=30)
     _interrupt_after(12, sac_trainer, spec)
