@@ -33,6 +33,11 @@ def test_loss_matches_numpy(quirks, value_loss):
     np.testing.assert_allclose([float(g) for g in got[:4]], want, rtol=1e-4, atol=1e-5)
     logp_new = tf.gather(tf.nn.log_softmax(logits), actions, batch_dims=1).numpy()
     assert float(got[4]) == pytest.approx(ref.approx_kl(logp_new, logp_old), rel=1e-4)
+    # clip fraction: the share of samples whose ratio left [1 - clip, 1 + clip]
+    p_old = np.exp(logp_old)
+    ratio = np.exp(logp_new) / (p_old + 1e-3) if quirks else np.exp(logp_new - logp_old)
+    share = np.mean(np.abs(ratio - 1.0) > cfg.clip)
+    assert 0 < share < 1 and float(got[5]) == pytest.approx(share)  # both kinds in the batch
 
 
 def test_ratio_is_clipped_only_where_it_helps():

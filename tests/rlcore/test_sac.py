@@ -154,3 +154,21 @@ def test_nan_reward_is_caught():
     batch[2][:] = np.nan
     with pytest.raises(FloatingPointError, match="SAC critic_loss is NaN"):
         agent.train_steps(*batch, np.random.default_rng(0))
+
+
+def test_log_std_is_clipped_to_its_bounds_when_acting_and_learning():
+    agent = SACAgent(OBS, ACT, CFG)
+    weights = agent.actor.get_weights()
+    weights[-2] = np.zeros_like(weights[-2])  # the output is its bias: mean 0.3, log std 8, -25 and 0
+    weights[-1] = np.array([0.3] * ACT + [8.0, -25.0, 0.0], np.float32)
+    agent.actor.set_weights(weights)
+    agent.sync_policy_weights()
+    obs = np.random.default_rng(0).normal(size=(4, OBS)).astype(np.float32)
+    bounds = [CFG.log_std_max, CFG.log_std_min, 0.0]
+    np.testing.assert_allclose(agent.mean_and_log_std(obs)[1], np.tile(bounds, (4, 1)))  # acting (numpy)
+    noise = np.random.default_rng(1).normal(size=(4, ACT)).astype(np.float32) * 0.3
+    action, logp = agent._policy(tf.constant(obs), tf.constant(noise))  # learning (TF)
+    want_a, want_logp = squashed_gaussian(tf.fill([4, ACT], 0.3), tf.constant(np.tile(bounds, (4, 1)), tf.float32),
+                                          tf.constant(noise))
+    np.testing.assert_allclose(action.numpy(), want_a.numpy(), rtol=1e-6)
+    np.testing.assert_allclose(logp.numpy(), want_logp.numpy(), rtol=1e-5)
