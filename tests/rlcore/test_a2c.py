@@ -137,3 +137,50 @@ def test_update_losses_match_numpy_on_a_rollout_with_truncations(normalize):
     assert got["critic_loss"] == pytest.approx(want_critic, rel=1e-4)
     assert got["entropy"] == pytest.approx(want_entropy, rel=1e-5)
     assert got["actor_loss"] == pytest.approx(total + 0.05 * want_entropy, rel=1e-4, abs=1e-5)
+
+
+def _clipped(grads, max_norm):
+    """Gradients scaled down to global norm ``max_norm`` (numpy, float64 norm)."""
+    norm = np.sqrt(sum(float(np.sum(np.asarray(g, np.float64) ** 2)) for g in grads))
+    return [g * (max_norm / norm) if norm > max_norm else g for g in grads], norm
+
+
+def test_two_clipped_updates_equal_an_eager_loop_with_a_numpy_clip():
+    """max_grad_norm scales each network's gradients to that global norm before Adam. Two updates,
+    since Adam's first step hardly depends on the gradient's scale."""
+    cfg = A2CConfig(n_steps=T, num_envs=N, actor_hidden=(16,), critic_hidden=(16,), reward_scale=1.0,
+                    gamma=0.9, gae_lambda=0.5, entropy_coef=0.01, max_grad_norm=0.05, actor_lr=1e-2,
+                    critic_lr=1e-2)
+    tf.keras.utils.set_random_seed(0)
+    agent, twin = A2CAgent(OBS, ACTIONS, cfg), A2CAgent(OBS, ACTIONS, cfg)
+    twin.set_weights(agent.get_weights())
+    rng = np.random.default_rng(8)
+    norms = []
+    for _ in range(2):
+        obs, next_obs = (rng.normal(size=(T, N, OBS)).astype(np.float32) for _ in range(2))
+        actions = rng.integers(0, ACTIONS, (T, N)).astype(np.int32)
+        rewards = rng.normal(scale=5.0, size=(T, N)).astype(np.float32)
+        _, _, _, terminated, dones = rollout(seed=3)
+        agent.update(obs, actions, rewards, next_obs, terminated, dones)
+
+        flat = obs.reshape(-1, OBS)
+        values = twin.critic.model(flat).numpy()[:, 0].reshape(T, N)
+        next_values = twin.critic.model(next_obs.reshape(-1, OBS)).numpy()[:, 0].reshape(T, N)
+        adv = ref.gae(rewards, values, next_values, terminated, dones, 0.9, 0.5)
+        targets = tf.constant((adv + values).ravel(), tf.float32)
+        with tf.GradientTape() as tape:
+            probs = twin.actor.model(flat, training=True)
+            loss = Actor.compute_loss(actions.ravel(), probs, tf.constant(adv.ravel(), tf.float32), 0.01)[0]
+        grads, norm = _clipped([g.numpy() for g in tape.gradient(loss, twin.actor.model.trainable_variables)],
+                               0.05)
+        twin.actor.opt.apply_gradients(zip(grads, twin.actor.model.trainable_variables))
+        norms.append(norm)
+        with tf.GradientTape() as tape:
+            loss = Critic.compute_loss(twin.critic.model(flat, training=True)[:, 0], targets)
+        grads, norm = _clipped([g.numpy() for g in tape.gradient(loss, twin.critic.model.trainable_variables)],
+                               0.05)
+        twin.critic.opt.apply_gradients(zip(grads, twin.critic.model.trainable_variables))
+        norms.append(norm)
+    assert min(norms) > 0.05 * 2  # the clip acted on every step
+    for got, want in zip(agent.get_weights(), twin.get_weights()):
+        np.testing.assert_allclose(got, want, rtol=1e-4, atol=1e-6)
