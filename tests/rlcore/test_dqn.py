@@ -175,3 +175,31 @@ def test_tutorial_epsilon_schedule():
     assert step_epsilon(DQN_ARTICLE, 0) == pytest.approx(0.9)
     assert step_epsilon(DQN_ARTICLE, 1000) == pytest.approx(0.05 + 0.85 / np.e)
     assert step_epsilon(DQN_ARTICLE, 100_000) == pytest.approx(0.05, abs=1e-12)
+
+
+def test_two_updates_with_clipped_gradients_equal_an_eager_loop_with_a_numpy_clip():
+    """grad_clip_value clips each gradient element to [-c, c] before the optimizer (CartPole's
+    tutorial: AdamW, amsgrad). Two steps, since the first hardly depends on the gradient's scale."""
+    cfg = DQNConfig(hidden=(16,), lr=1e-2, optimizer="adamw", loss="mse", grad_clip_value=0.05, tau=0.1)
+    tf.keras.utils.set_random_seed(0)
+    agent, twin = DQNAgent(OBS, ACTIONS, cfg), DQNAgent(OBS, ACTIONS, cfg)
+    for mine, theirs in zip(agent.models().values(), twin.models().values()):
+        theirs.set_weights(mine.get_weights())
+    clipped_share = []
+    for seed in (1, 2):
+        obs, action, reward, next_obs, terminated = random_batch(seed)
+        reward = reward * 10  # large errors, so most gradient elements pass the clip
+        agent.train_step(obs, action, reward, next_obs, terminated)
+        target = twin.td_target(reward, next_obs, terminated)
+        with tf.GradientTape() as tape:
+            q = tf.gather(twin.q_network(obs, training=True), action, batch_dims=1)
+            loss = tf.reduce_mean(tf.square(target - q))
+        grads = [g.numpy() for g in tape.gradient(loss, twin.q_network.trainable_variables)]
+        clipped_share.append(np.mean(np.concatenate([np.abs(g).ravel() > 0.05 for g in grads])))
+        twin.optimizer.apply_gradients(zip([np.clip(g, -0.05, 0.05) for g in grads],
+                                           twin.q_network.trainable_variables))
+        twin.soft_update()
+    assert min(clipped_share) > 0.2, clipped_share
+    for mine, theirs in zip(agent.models().values(), twin.models().values()):
+        for got, want in zip(mine.get_weights(), theirs.get_weights()):
+            np.testing.assert_allclose(got, want, rtol=1e-4, atol=1e-6)
