@@ -87,6 +87,12 @@ def ppo_loss(logits, values, actions, logp_old, advantages, targets, clip, value
     return policy + value_coef * value_sq.mean() - entropy_coef * entropy.mean(), policy, value_sq.mean(), entropy.mean()
 
 
+def clip_by_global_norm(grads, max_norm):
+    """Gradients scaled down to global norm ``max_norm`` when above it; returns (grads, the norm)."""
+    norm = np.sqrt(sum(float(np.sum(np.asarray(g, np.float64) ** 2)) for g in grads))
+    return [g * (max_norm / norm) if norm > max_norm else g for g in grads], norm
+
+
 def approx_kl(logp_new, logp_old):
     """KL(pi_old || pi) estimated from the taken actions: mean of (r - 1) - log r, r = pi / pi_old."""
     log_ratio = np.asarray(logp_new, np.float64) - np.asarray(logp_old, np.float64)

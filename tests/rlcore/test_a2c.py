@@ -139,12 +139,6 @@ def test_update_losses_match_numpy_on_a_rollout_with_truncations(normalize):
     assert got["actor_loss"] == pytest.approx(total + 0.05 * want_entropy, rel=1e-4, abs=1e-5)
 
 
-def _clipped(grads, max_norm):
-    """Gradients scaled down to global norm ``max_norm`` (numpy, float64 norm)."""
-    norm = np.sqrt(sum(float(np.sum(np.asarray(g, np.float64) ** 2)) for g in grads))
-    return [g * (max_norm / norm) if norm > max_norm else g for g in grads], norm
-
-
 def test_two_clipped_updates_equal_an_eager_loop_with_a_numpy_clip():
     """max_grad_norm scales each network's gradients to that global norm before Adam. Two updates,
     since Adam's first step hardly depends on the gradient's scale."""
@@ -171,13 +165,13 @@ def test_two_clipped_updates_equal_an_eager_loop_with_a_numpy_clip():
         with tf.GradientTape() as tape:
             probs = twin.actor.model(flat, training=True)
             loss = Actor.compute_loss(actions.ravel(), probs, tf.constant(adv.ravel(), tf.float32), 0.01)[0]
-        grads, norm = _clipped([g.numpy() for g in tape.gradient(loss, twin.actor.model.trainable_variables)],
+        grads, norm = ref.clip_by_global_norm([g.numpy() for g in tape.gradient(loss, twin.actor.model.trainable_variables)],
                                0.05)
         twin.actor.opt.apply_gradients(zip(grads, twin.actor.model.trainable_variables))
         norms.append(norm)
         with tf.GradientTape() as tape:
             loss = Critic.compute_loss(twin.critic.model(flat, training=True)[:, 0], targets)
-        grads, norm = _clipped([g.numpy() for g in tape.gradient(loss, twin.critic.model.trainable_variables)],
+        grads, norm = ref.clip_by_global_norm([g.numpy() for g in tape.gradient(loss, twin.critic.model.trainable_variables)],
                                0.05)
         twin.critic.opt.apply_gradients(zip(grads, twin.critic.model.trainable_variables))
         norms.append(norm)

@@ -110,9 +110,9 @@ def test_compiled_update_equals_an_eager_minibatch_loop(target_kl, max_grad_norm
         if target_kl and kls[-1] > 1.5 * target_kl:
             break
         grads = [g.numpy() for g in tape.gradient(loss, twin.model.trainable_variables)]
-        norms.append(np.sqrt(sum(float(np.sum(g.astype(np.float64) ** 2)) for g in grads)))
-        if max_grad_norm and norms[-1] > max_grad_norm:
-            grads = [g * (max_grad_norm / norms[-1]) for g in grads]
+        if max_grad_norm:
+            grads, norm = ref.clip_by_global_norm(grads, max_grad_norm)
+            norms.append(norm)
         twin.opt.apply_gradients(zip(grads, twin.model.trainable_variables))
         taken += 1
     for got, want in zip(agent.model.get_weights(), twin.model.get_weights()):

@@ -68,6 +68,16 @@ def test_sac_learns_the_reach_task(tmp_path):
     assert steps.sum() == 2500 and steps.min() >= 1
 
 
+def _end_by_termination(monkeypatch, env_class):
+    """Make a toy env end its episodes by termination where its time limit would truncate them."""
+    step = env_class.step
+
+    def terminating_step(self, action):
+        obs, reward, terminated, truncated, info = step(self, action)
+        return obs, reward, terminated or truncated, False, info
+    monkeypatch.setattr(env_class, "step", terminating_step)
+
+
 @pytest.mark.parametrize("ending", ["time limit", "termination"])
 @pytest.mark.parametrize("algo", ["dqn", "sac"])
 def test_replay_marks_terminations_only_so_a_time_limit_still_bootstraps(algo, ending, tmp_path, monkeypatch):
@@ -76,12 +86,9 @@ def test_replay_marks_terminations_only_so_a_time_limit_still_bootstraps(algo, e
     from rlcore.replay import ReplayMemory
 
     env_class = {"dqn": toy.SignEnv, "sac": toy.ReachEnv}[algo]
-    step, add, stored = env_class.step, ReplayMemory.add, []
+    add, stored = ReplayMemory.add, []
     if ending == "termination":
-        def terminating_step(self, action):
-            obs, reward, terminated, truncated, info = step(self, action)
-            return obs, reward, terminated or truncated, False, info
-        monkeypatch.setattr(env_class, "step", terminating_step)
+        _end_by_termination(monkeypatch, env_class)
 
     def recording_add(self, obs, action, reward, next_obs, terminated):
         stored.append(float(terminated))
@@ -100,12 +107,9 @@ def test_a2c_rollouts_mark_terminations_apart_from_episode_ends(ending, tmp_path
     (a time limit bootstraps); swapped, the GAE would bootstrap through real ends."""
     from rlcore.agents.a2c import A2CAgent
 
-    step, update, seen = toy.SignEnv.step, A2CAgent.update, []
+    update, seen = A2CAgent.update, []
     if ending == "termination":
-        def terminating_step(self, action):
-            obs, reward, terminated, truncated, info = step(self, action)
-            return obs, reward, terminated or truncated, False, info
-        monkeypatch.setattr(toy.SignEnv, "step", terminating_step)
+        _end_by_termination(monkeypatch, toy.SignEnv)
 
     def recording_update(self, obs, actions, rewards, next_obs, terminated, dones):
         seen.append((terminated.copy(), dones.copy()))
