@@ -143,11 +143,7 @@ def plot_endings(csv_path: str | Path, png_path: str | Path, title: str, progres
         share.set_ylabel("stalled, %")
         share.legend(loc="upper left")
     ax.set_title(title)
-    fig.tight_layout()
-    with atomic_path(png_path) as tmp:
-        fig.savefig(tmp, dpi=100)
-    plt.close(fig)
-    return Path(png_path)
+    return _write(fig, png_path)
 
 
 def _table(csv_path: str | Path, *columns: str) -> pd.DataFrame:
@@ -163,9 +159,15 @@ def _table(csv_path: str | Path, *columns: str) -> pd.DataFrame:
 
 
 def _save(fig, ax, title, png_path) -> Path:
+    """A line plot's title, grid and legend, then the file."""
     ax.set_title(title)
     ax.grid(alpha=0.3)
     ax.legend(loc="lower right")
+    return _write(fig, png_path)
+
+
+def _write(fig, png_path) -> Path:
+    """The figure as a PNG, written whole or not at all, then closed."""
     fig.tight_layout()
     with atomic_path(png_path) as tmp:
         fig.savefig(tmp, dpi=100)

@@ -75,7 +75,7 @@ def train(spec: RunSpec) -> Path:
                 break
             means = episode_means(losses, ("critic_loss", "actor_loss", "alpha", "entropy", "q_mean"))
             # episode_steps: how long it stood (Minitaur: a fall ends it before the time limit)
-            ends = {k: float(info.get(k, float("nan"))) for k in spec.experiment.info_keys}
+            ends = {key: float(info.get(key, float("nan"))) for key in spec.experiment.info_keys}
             session.end_episode(episode_return, {"episode_steps": episode_steps, **ends, "grad_steps": grad_steps,
                                                  **means})
             if session.book.episodes % cfg.checkpoint_every == 0:
