@@ -4,6 +4,8 @@ Stack, innermost first::
 
     SuperMarioBros-<world>-<stage>-v0        the emulator, one NES frame per step
     JoypadSpace(SIMPLE_MOVEMENT | ...)       discrete button combinations
+    Restarts                                 training only: start some episodes where an earlier one
+                                             passed an x (off by default, mario_ppo/restarts.py)
     ClassicReward                            the reward gym-super-mario-bros had before 9.x
                                              (+ game score x score_reward, off by default)
     ArticleShaping                           +50 flag / -50 other ends, then / 10
@@ -36,7 +38,7 @@ import numpy as np
 ACTION_SETS = ("simple", "complex", "right_only")
 FRAME_STACKS = ("skipped", "history")
 FRAME_SIZE = 84
-INFO_KEYS = ("x_pos", "flag_get", "time", "world", "stage")  # what the wrappers pass on
+INFO_KEYS = ("x_pos", "flag_get", "time", "world", "stage", "restarted")  # what the wrappers pass on
 
 
 def action_list(name: str) -> list:
@@ -270,16 +272,18 @@ def _trim(info: dict) -> dict:
 def make_env(render_mode: str | None = None, max_episode_steps: int | None = None, world: int = 1,
              stage: int = 1, actions: str = "simple", skip: int = 4, score_reward: float = 0.0,
              stall_steps: int = 0, stall_outcome: str = "truncate", frames: str = "skipped",
-             dead_ends: bool = False) -> gym.Env:
+             dead_ends: bool = False, restart_x: int = 0, restart_share: float = 0.0) -> gym.Env:
     """The article's Mario env for one stage. ``max_episode_steps`` counts agent steps (None = none);
     ``score_reward``: reward per game-score point (0 = the article's reward); ``stall_steps``: end
     an episode after this many agent steps without a new best x (0 = never), as a truncation or as a
     death (``stall_outcome``); ``frames``: the 4 channels hold the 4 frames of this step ("skipped") or
     the last 4 steps ("history", see :class:`SkipAndHistory`); ``dead_ends``: end an episode as a death
-    in a known dead end of the level (:data:`DEAD_ENDS`)."""
+    in a known dead end of the level (:data:`DEAD_ENDS`); ``restart_x``, ``restart_share``: start
+    that share of episodes where an earlier one passed that x (training only, :mod:`mario_ppo.restarts`)."""
     import gym_super_mario_bros  # noqa: F401  registers the SuperMarioBros-* ids
     from nes_py.wrappers import JoypadSpace
 
+    from mario_ppo.restarts import Restarts
     from rlcore.errors import UserError
 
     if not (1 <= world <= 8 and 1 <= stage <= 4):
@@ -288,6 +292,8 @@ def make_env(render_mode: str | None = None, max_episode_steps: int | None = Non
         raise UserError(f"unknown frame stack {frames!r}; choose one of {', '.join(FRAME_STACKS)}")
     env = gym.make(f"SuperMarioBros-{world}-{stage}-v0", render_mode=render_mode).unwrapped
     env = JoypadSpace(env, action_list(actions))
+    if restart_x and restart_share:
+        env = Restarts(env, restart_x, restart_share)
     stack = SkipAndHistory if frames == "history" else SkipAndStack
     env = stack(ArticleShaping(ClassicReward(env, score_reward)), skip)
     if dead_ends:

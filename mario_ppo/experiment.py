@@ -36,6 +36,13 @@ class MarioPPOConfig(PPOConfig):
     stall_outcome: str = field(default="truncate", metadata={
         "help": "how a stall ends: truncate (bootstrapped from V) or death (terminated, -50 / 10, "
                 "as the clock would end it)", "allowed": choices(*StallLimit.OUTCOMES)})
+    restart_x: int = field(default=0, metadata={
+        "help": "training only: start a share (--restart-share) of episodes from the state in which an "
+                "earlier episode first passed this x, to practise a hard place far into the level; "
+                "evaluation always starts at the level's start (0 = off)", "allowed": OFF_OR_COUNT})
+    restart_share: float = field(default=0.5, metadata={
+        "help": "with --restart-x: the share of training episodes that start there; they are left out "
+                "of the flag share the stop rule reads", "allowed": Allowed(low=0, high=1)})
 
 
 # Article 001: 8 envs x 512 steps, GAE gamma 0.99 lambda 0.97, clip 0.2, entropy 0.05, Adam 1e-4,
@@ -71,7 +78,8 @@ EXPERIMENT = Experiment(
     algos={"ppo": AlgoSpec("ppo", "ppo", "PPO, 8 envs over Pipes", {"article": ARTICLE, "default": DEFAULT})},
     video_fps=60,
     env_fields=("world", "stage", "actions", "score_reward", "stall_steps", "stall_outcome",
-                "frames", "dead_ends"), success_key="flag_get", progress_key="x_pos",
+                "frames", "dead_ends"), train_env_fields=("restart_x", "restart_share"),
+    success_key="flag_get", progress_key="x_pos", partial_key="restarted",
     info_keys=("stalled",),
     eval_episodes=10, ship_by=("world", "stage"), default_model="1-1", score_label="return (shaped, /10)",
 )

@@ -54,6 +54,12 @@ class Experiment:
     # trainers, and in the evaluation's per-episode records (Mario: stalled, 1 when the stall limit
     # ended it; Minitaur: x, metres walked)
     info_keys: tuple[str, ...] = ()
+    # config fields that make_env takes in training only (Mario: restart_x, restart_share): the
+    # trainer's env pool gets them; evaluations, videos and saved models build the env without them
+    train_env_fields: tuple[str, ...] = ()
+    # an info key that marks an episode that did not start where evaluation starts (Mario: restarted):
+    # it trains like any other, but its success is left out of the success share the stop rule reads
+    partial_key: str | None = None
     # config fields that name a shipped model (Mario: world, stage -> saved_networks/mario_ppo/1-1);
     # empty: one model per algorithm, saved_networks/EXPERIMENT/ALGO
     ship_by: tuple[str, ...] = ()
@@ -62,6 +68,10 @@ class Experiment:
     plot_prefix: str = ""  # the plot files' name prefix (empty: the experiment's name)
     video_fps: int = 30
     episodes_per_video: int = 1
+
+    def training_env_factory(self, config) -> Callable:
+        """:meth:`env_factory` plus the training-only fields (``train_env_fields``)."""
+        return self.env_factory(config, **{name: getattr(config, name) for name in self.train_env_fields})
 
     def env_factory(self, config=None, **kwargs) -> Callable:
         """A picklable no-argument env constructor for ``config`` (env-pool workers call it).

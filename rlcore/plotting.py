@@ -37,9 +37,9 @@ def plot_run(run_dir: str | Path, out_dir: str | Path, experiment, about: dict) 
                                experiment.solved_score, label)]
     if experiment.progress_key:
         out.append(plot_progress(metrics, out_dir / f"{prefix}_Progress_{algo}.png", title,
-                                 experiment.progress_key, window))
+                                 experiment.progress_key, window, experiment.partial_key))
         out.append(plot_endings(metrics, out_dir / f"{prefix}_Endings_{algo}.png", title,
-                                experiment.progress_key))
+                                experiment.progress_key, experiment.partial_key))
     if evals.exists():
         out.append(plot_evaluations(evals, out_dir / f"{prefix}_Eval_{algo}.png", title,
                                     experiment.solved_score, label))
@@ -84,10 +84,11 @@ def plot_evaluations(csv_path: str | Path, png_path: str | Path, title: str,
 
 
 def plot_progress(csv_path: str | Path, png_path: str | Path, title: str, progress_key: str,
-                  window: int = 100) -> Path:
+                  window: int = 100, partial_key: str | None = None) -> Path:
     """Episodes with a goal (Mario's flag): how far each got (``progress_key``, with its moving
-    average) and, on the right axis, the share of the last ``window`` episodes that succeeded."""
-    df = _table(csv_path, "episode", progress_key)
+    average) and, on the right axis, the share of the last ``window`` episodes that succeeded.
+    Episodes marked by ``partial_key`` (Mario's restarts, which start further in) are left out."""
+    df = _full_episodes(_table(csv_path, "episode", progress_key), partial_key)
     fig, ax = plt.subplots(figsize=(9, 5))
     ax.plot(df["episode"], df[progress_key], color="tab:blue", linewidth=1, alpha=0.5, label=progress_key)
     ax.plot(df["episode"], df[progress_key].rolling(window, min_periods=1).mean(), color="tab:orange",
@@ -122,10 +123,11 @@ def ending_shares(progress: np.ndarray, block: int, bins: int = 40) -> tuple[np.
 
 
 def plot_endings(csv_path: str | Path, png_path: str | Path, title: str, progress_key: str,
-                 blocks: int = 60) -> Path:
+                 partial_key: str | None = None, blocks: int = 60) -> Path:
     """A map of where episodes ended (``progress_key``, e.g. Mario's x) over training: the dark rows
-    are where the agent keeps dying or stalling. Episodes with a ``stalled`` mark add its share."""
-    df = _table(csv_path, "episode", progress_key)
+    are where the agent keeps dying or stalling. Episodes with a ``stalled`` mark add its share.
+    Episodes marked by ``partial_key`` (Mario's restarts, which start further in) are left out."""
+    df = _full_episodes(_table(csv_path, "episode", progress_key), partial_key)
     block = max(1, int(np.ceil(len(df) / blocks)))
     starts, edges, shares = ending_shares(df[progress_key].to_numpy(), block)
     fig, ax = plt.subplots(figsize=(9, 5))
@@ -144,6 +146,11 @@ def plot_endings(csv_path: str | Path, png_path: str | Path, title: str, progres
         share.legend(loc="upper left")
     ax.set_title(title)
     return _write(fig, png_path)
+
+
+def _full_episodes(df: pd.DataFrame, partial_key: str | None) -> pd.DataFrame:
+    """The rows of episodes that started where evaluations start (not marked by ``partial_key``)."""
+    return df[df[partial_key] != 1] if partial_key and partial_key in df else df
 
 
 def _table(csv_path: str | Path, *columns: str) -> pd.DataFrame:

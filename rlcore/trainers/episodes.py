@@ -18,7 +18,7 @@ class EpisodeBook:
                  successes: list[bool] | None = None):
         self.window, self.solved_score = window, solved_score
         self.returns: list[float] = list(returns or [])
-        self.successes: list[bool] = list(successes or [])  # only episodes that report success
+        self.successes: list[bool] = list(successes or [])  # only counted episodes that report success
         self.solved_episode: int | None = None
 
     @property
@@ -38,8 +38,10 @@ class EpisodeBook:
     def full_window(self) -> bool:
         return len(self.returns) >= self.window
 
-    def add(self, episode_return: float, success: bool | None = None) -> dict:
-        """Record one episode; return the article's per-episode metrics (and success, when given)."""
+    def add(self, episode_return: float, success: bool | None = None, counted: bool = True) -> dict:
+        """Record one episode; return the article's per-episode metrics (and success, when given).
+        An episode not ``counted`` (it started elsewhere than evaluations do) logs its success but
+        leaves the success share as it was."""
         self.returns.append(float(episode_return))
         if (self.solved_score is not None and self.solved_episode is None and self.full_window()
                 and self.average >= self.solved_score):
@@ -51,6 +53,7 @@ class EpisodeBook:
         row = {"episode": self.episodes, "total_points": float(episode_return),
                "av_latest_points": self.average, "target_ave_scores": self.solved_score}
         if success is not None:
-            self.successes.append(bool(success))
+            if counted:
+                self.successes.append(bool(success))
             row.update(success=int(success), success_share=self.success_share)
         return row

@@ -47,12 +47,12 @@ class Rollout:
 def train(spec: RunSpec) -> Path:
     cfg, exp = spec.config, spec.experiment
     keras.utils.set_random_seed(spec.seed)
-    make_env = exp.env_factory(cfg)
+    make_env = exp.training_env_factory(cfg)
     envs = EnvPool([make_env] * cfg.num_envs, mode=cfg.vec)
     obs_shape, n_actions = envs.single_observation_space.shape, int(envs.single_action_space.n)
     agent = PPOAgent(obs_shape, n_actions, cfg)
     rng = np.random.default_rng(spec.seed)
-    success_key, progress_key = exp.success_key, exp.progress_key
+    success_key, progress_key, partial_key = exp.success_key, exp.progress_key, exp.partial_key
 
     state, _ = checkpoints.restore(spec, agent, rng)
     if state is not None:
@@ -75,6 +75,7 @@ def train(spec: RunSpec) -> Path:
     with envs, session.interruptible():
         while not session.should_stop():
             max_x, min_x, ended, flags = -np.inf, np.inf, 0, 0
+            partial_ended, partial_flags = 0, 0  # episodes that did not start at the start (restarts)
             truncated_values = {}
             for step in range(t):
                 actions, logp, values = agent.act(obs, rng)
@@ -92,16 +93,21 @@ def train(spec: RunSpec) -> Path:
                     truncated_values.update({(step, i): float(v) for i, v in zip(cut, finals)})
                 for i in np.flatnonzero(done):
                     extra, won = dict(losses), None
+                    partial = bool(partial_key and final_info(infos, partial_key, i, False))
+                    if partial_key:
+                        extra[partial_key] = float(partial)
+                        partial_ended += partial
                     if progress_key:
                         x = float(final_info(infos, progress_key, i))
                         max_x, min_x = max(max_x, x), min(min_x, x)
                         extra[progress_key] = x
                     if success_key:
                         won = bool(final_info(infos, success_key, i, False))
-                        flags += won
+                        flags += won and not partial
+                        partial_flags += won and partial
                     for key in exp.info_keys:  # NaN where the env did not report it
                         extra[key] = float(final_info(infos, key, i, float("nan")))
-                    session.end_episode(running[i], extra, success=won)
+                    session.end_episode(running[i], extra, success=won, counted=not partial)
                     running[i] = 0.0
                     ended += 1
                 obs = next_obs
@@ -110,14 +116,19 @@ def train(spec: RunSpec) -> Path:
             with reported_divergence(session, "PPO", "lower --lr"):
                 losses = agent.update(*buf.arrays(), rng)
             rollouts += 1
-            session.log_rollout(rollouts, {"episodes_ended": ended, "successes": flags,
-                                           f"max_{progress_key or 'x'}": max_x, **losses})
+            row = {"episodes_ended": ended, "successes": flags}
+            if partial_key:
+                row.update({f"{partial_key}_episodes": partial_ended, f"{partial_key}_successes": partial_flags})
+            session.log_rollout(rollouts, {**row, f"max_{progress_key or 'x'}": max_x, **losses})
             line = f"rollout {rollouts} | env steps {session.env_steps:,} | episodes {book.episodes:,}"
             if progress_key:
                 line += (f" | max {progress_key} {max_x:.0f} | min {progress_key} "
                          f"{min_x if np.isfinite(min_x) else float('nan'):.0f}")
             if success_key:
-                line += f" | {success_key} {flags}/{ended} (last {cfg.window}: {book.success_share:.0%})"
+                line += (f" | {success_key} {flags}/{ended - partial_ended} (last {cfg.window}: "
+                         f"{book.success_share:.0%})")
+                if partial_ended:
+                    line += f" | {partial_key} {partial_flags}/{partial_ended}"
             tqdm.write(line + f" | loss {losses['loss']:.3f} entropy {losses['entropy']:.2f}")
             if rollouts % cfg.checkpoint_rollouts == 0:
                 checkpoint()

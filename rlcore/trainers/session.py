@@ -75,9 +75,11 @@ class TrainingSession:
     def elapsed(self) -> float:
         return self._wall_before + time.perf_counter() - self._started
 
-    def end_episode(self, episode_return: float, extra: dict, success: bool | None = None) -> None:
-        """Log one finished episode (and whether it succeeded, for goal experiments)."""
-        row = self.book.add(episode_return, success)
+    def end_episode(self, episode_return: float, extra: dict, success: bool | None = None,
+                    counted: bool = True) -> None:
+        """Log one finished episode (and whether it succeeded, for goal experiments; ``counted=False``:
+        not toward the success share, an episode that did not start where evaluation starts)."""
+        row = self.book.add(episode_return, success, counted)
         row.update(env_steps=self.env_steps, wall_seconds=round(self.elapsed(), 2), **extra)
         self.tracker.log(row)
         self.progress.episode(self.book, self.env_steps)

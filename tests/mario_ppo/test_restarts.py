@@ -1,0 +1,80 @@
+"""Restarts on the real emulator: training episodes may start where an earlier episode passed an x;
+evaluation envs never do."""
+import dataclasses
+
+import numpy as np
+
+from mario_ppo.env import make_env
+from mario_ppo.experiment import EXPERIMENT
+from mario_ppo.restarts import Restarts
+
+RIGHT = 1  # SIMPLE_MOVEMENT[1] == ['right']
+X = 200
+
+
+def _run_right_past(env, x):
+    while True:
+        obs, _, terminated, truncated, info = env.step(RIGHT)
+        assert not (terminated or truncated)
+        if info["x_pos"] >= x:
+            return obs, info
+
+
+def test_after_an_episode_passed_x_a_restart_starts_there_and_keeps_that_state():
+    env = make_env(restart_x=X, restart_share=1.0)
+    try:
+        start_obs, info = env.reset(seed=0)
+        assert info["restarted"] is False and info["x_pos"] < X  # nothing kept yet: the level's start
+        _, passed = _run_right_past(env, X)
+        restarts = []
+        for seed in (1, 2):
+            obs, info = env.reset(seed=seed)
+            restarts.append(info["x_pos"])
+            assert info["restarted"] is True and X <= info["x_pos"] <= passed["x_pos"]
+            assert not np.array_equal(obs, start_obs)  # the screen there, not the level's first frame
+            _, _, _, _, info = env.step(RIGHT)
+            assert info["restarted"] is True and info["x_pos"] >= restarts[-1]
+            for _ in range(30):  # a restarted episode plays on from there
+                if any(env.step(RIGHT)[2:4]):
+                    break
+        assert restarts[0] == restarts[1]
+    finally:
+        env.close()
+
+
+def test_the_share_of_restarts_follows_the_seeded_rng():
+    def restarted(share):
+        env = make_env(restart_x=X, restart_share=share)
+        env.reset(seed=0)
+        _run_right_past(env, X)
+        marks = [env.reset(seed=s)[1]["restarted"] for s in range(1, 41)]
+        env.close()
+        return marks
+
+    half = restarted(0.5)
+    assert 10 <= sum(half) <= 30 and half == restarted(0.5)
+    plain = make_env(restart_x=X, restart_share=0.0)  # share 0: no Restarts wrapper at all
+    assert "restarted" not in plain.reset(seed=0)[1]
+    plain.close()
+
+
+def test_restarts_reach_the_training_envs_only():
+    cfg = dataclasses.replace(EXPERIMENT.preset("ppo", "default"), restart_x=X, restart_share=0.25)
+
+    def wrappers(env):
+        found = []
+        while hasattr(env, "env"):
+            found.append(type(env))
+            env = env.env
+        return found
+
+    training = EXPERIMENT.training_env_factory(cfg)()
+    evaluation = EXPERIMENT.env_factory(cfg)()  # what evaluate, render and a saved model's policy build
+    try:
+        kept = [w for w in wrappers(training) if w is Restarts]
+        assert kept and training.get_wrapper_attr("share") == 0.25
+        assert Restarts not in wrappers(evaluation)
+        assert "restarted" not in evaluation.reset(seed=0)[1]
+    finally:
+        training.close()
+        evaluation.close()

@@ -1,0 +1,67 @@
+"""Episodes that start elsewhere than evaluations do (Mario's restarts): the PPO trainer builds its envs
+with the training-only fields, trains on such episodes, logs them, and leaves them out of the success
+share that the stop rule reads."""
+import dataclasses
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from rlcore.configs import PPOConfig
+from rlcore.trainers import ppo as ppo_trainer
+from rlcore.trainers.episodes import EpisodeBook
+from tests import toy
+
+pytestmark = pytest.mark.usefixtures("toy_experiments")
+
+
+@dataclasses.dataclass(frozen=True)
+class PartialConfig(PPOConfig):
+    partial_every: int = 0  # a training-only env field, as Mario's restart_x
+
+
+class PartlyRestartedEnv(toy.ImageSignEnv):
+    """Every ``partial_every``-th episode of an env is marked partial; only those are won."""
+
+    def __init__(self, max_episode_steps=10, render_mode=None, partial_every=0):
+        super().__init__(max_episode_steps, render_mode)
+        self.partial_every, self.count, self.partial = partial_every, 0, False
+
+    def _info(self):
+        return {"score": self.score, "won": self.partial, "partial": self.partial}
+
+    def reset(self, *, seed=None, options=None):
+        self.count += 1
+        self.partial = bool(self.partial_every) and self.count % self.partial_every == 0
+        return super().reset(seed=seed, options=options)
+
+
+def test_partial_episodes_train_and_are_logged_but_not_counted_toward_the_success_share(tmp_path):
+    spec = toy.spec("ppo", tmp_path, max_episodes=40, stop_success_share=0.3)
+    spec.config = PartialConfig(**{f.name: getattr(spec.config, f.name)
+                                   for f in dataclasses.fields(spec.config)}, partial_every=2)
+    spec.experiment = dataclasses.replace(
+        spec.experiment, make_env=lambda render_mode=None, max_episode_steps=10, partial_every=0:
+        PartlyRestartedEnv(max_episode_steps, render_mode, partial_every),
+        train_env_fields=("partial_every",), partial_key="partial")
+    meta_dir = ppo_trainer.train(spec)
+    rows = pd.read_csv(spec.run_dir / "metrics.csv")
+    # half the episodes were partial (so the trainer's envs got the training-only field) and won
+    assert rows["partial"].sum() == pytest.approx(len(rows) / 2, abs=2)
+    assert (rows["success"] == rows["partial"]).all()
+    # ... yet the share of won counted episodes stayed 0, so the 0.3 stop rule never fired
+    assert (rows["success_share"] == 0).all()
+    assert "max_episodes" in (meta_dir / "meta.json").read_text()
+    rollouts = pd.read_csv(spec.run_dir / "rollouts.csv")
+    assert rollouts["partial_episodes"].sum() == rows["partial"].sum()
+    assert rollouts["partial_successes"].sum() == rows["partial"].sum() and rollouts["successes"].sum() == 0
+
+
+def test_an_episode_not_counted_logs_its_success_but_leaves_the_share():
+    book = EpisodeBook(window=4, solved_score=None)
+    rows = [book.add(1.0, success=s, counted=c)
+            for s, c in [(False, True), (True, False), (True, True), (True, False)]]
+    assert [r["success"] for r in rows] == [0, 1, 1, 1]
+    assert book.successes == [False, True] and book.success_share == 0.5
+    assert [r["success_share"] for r in rows] == [0.0, 0.0, 0.5, 0.5]
+    assert np.isclose(book.average, 1.0) and book.episodes == 4  # returns count every episode
