@@ -387,10 +387,19 @@ def _add_hyperparameters(train: argparse.ArgumentParser, argv: list[str]) -> Non
     """Once EXPERIMENT and ALGO are on the command line, add one flag per hyperparameter.
 
     A first, forgiving parse finds them (and ``--preset``) wherever they stand; a line it cannot
-    read is left to the full parse, which reports it.
+    read is left to the full parse, which reports it. Hyperparameter flags are not known yet, so
+    it steps over any other ``--name value`` pair (every hyperparameter takes one value): a
+    ``--lr 1e-3`` before the names does not make ``1e-3`` the experiment.
     """
     if argv[:1] != ["train"]:
         return
+    known = {option for action in train._actions for option in action.option_strings}
+    line, tokens = [], iter(argv[1:])
+    for token in tokens:
+        if token.startswith("--") and "=" not in token and token not in known:
+            next(tokens, None)
+        elif token not in ("-h", "--help"):
+            line.append(token)
     first = _QuietParser(add_help=False)
     first.add_argument("experiment")
     first.add_argument("algo")
@@ -402,7 +411,7 @@ def _add_hyperparameters(train: argparse.ArgumentParser, argv: list[str]) -> Non
             else:
                 first.add_argument(*action.option_strings, nargs=action.nargs, const=action.const)
     try:
-        names, _ = first.parse_known_args([a for a in argv[1:] if a not in ("-h", "--help")])
+        names, _ = first.parse_known_args(line)
     except _Unparsable:
         return
     from rlcore.experiment import get_experiment

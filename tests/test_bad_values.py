@@ -160,6 +160,13 @@ def test_preset_before_the_names_still_adds_the_hyperparameters(capsys):
     assert code == 0 and "--tau FLOAT" in out
 
 
+def test_hyperparameters_before_the_names_are_read_as_hyperparameters(capsys):
+    code, out, _ = run(capsys, "train", "--tau", "0.5", "--preset", "article", "lunar_lander", "dqn", "--help")
+    assert code == 0 and "--tau FLOAT" in out
+    code, _, err = run(capsys, "train", "--tau", "7", "lunar_lander", "dqn")
+    assert code == 2 and "--tau" in err and "7" in err and "unknown experiment" not in err
+
+
 @pytest.mark.parametrize("seed", [0, 7, 999, 1000, 123_456, MAX_RUN_SEED])
 def test_training_seeds_never_reach_the_evaluation_or_selection_seeds(seed):
     lowest = min(min(get_experiment(n).eval_seed_base, get_experiment(n).selection_seed_base)
