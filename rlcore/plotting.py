@@ -34,7 +34,7 @@ def plot_run(run_dir: str | Path, out_dir: str | Path, experiment, about: dict) 
     label = experiment.score_label
     metrics, evals = run_dir / "metrics.csv", run_dir / "evals.csv"
     out = [plot_episode_scores(metrics, out_dir / f"{prefix}_Train_{algo}.png", title,
-                               experiment.solved_score, label)]
+                               experiment.solved_score, label, experiment.partial_key)]
     if experiment.progress_key:
         out.append(plot_progress(metrics, out_dir / f"{prefix}_Progress_{algo}.png", title,
                                  experiment.progress_key, window, experiment.partial_key))
@@ -54,9 +54,15 @@ def plot_title(experiment, about: dict) -> str:
 
 
 def plot_episode_scores(csv_path: str | Path, png_path: str | Path, title: str,
-                        solved_score: float | None = None, score_label: str = "return") -> Path:
-    """Score per episode, its moving average and the solved line, as in article 000's figure."""
+                        solved_score: float | None = None, score_label: str = "return",
+                        partial_key: str | None = None) -> Path:
+    """Score per episode, its moving average and the solved line, as in article 000's figure.
+    Episodes marked by ``partial_key`` (Mario's restarts) are left out, and the average is taken
+    over the others."""
     df = _table(csv_path, "episode", "total_points", "av_latest_points")
+    if partial_key and partial_key in df:
+        df = full_episodes(df, partial_key)
+        df = df.assign(av_latest_points=df["total_points"].rolling(100, min_periods=1).mean())
     fig, ax = plt.subplots(figsize=(9, 5))
     ax.plot(df["episode"], df["total_points"], color="tab:blue", linewidth=1, alpha=0.6, label="Score")
     ax.plot(df["episode"], df["av_latest_points"], color="tab:orange", linewidth=2, linestyle="--",
@@ -88,7 +94,7 @@ def plot_progress(csv_path: str | Path, png_path: str | Path, title: str, progre
     """Episodes with a goal (Mario's flag): how far each got (``progress_key``, with its moving
     average) and, on the right axis, the share of the last ``window`` episodes that succeeded.
     Episodes marked by ``partial_key`` (Mario's restarts, which start further in) are left out."""
-    df = _full_episodes(_table(csv_path, "episode", progress_key), partial_key)
+    df = full_episodes(_table(csv_path, "episode", progress_key), partial_key)
     fig, ax = plt.subplots(figsize=(9, 5))
     ax.plot(df["episode"], df[progress_key], color="tab:blue", linewidth=1, alpha=0.5, label=progress_key)
     ax.plot(df["episode"], df[progress_key].rolling(window, min_periods=1).mean(), color="tab:orange",
@@ -127,7 +133,7 @@ def plot_endings(csv_path: str | Path, png_path: str | Path, title: str, progres
     """A map of where episodes ended (``progress_key``, e.g. Mario's x) over training: the dark rows
     are where the agent keeps dying or stalling. Episodes with a ``stalled`` mark add its share.
     Episodes marked by ``partial_key`` (Mario's restarts, which start further in) are left out."""
-    df = _full_episodes(_table(csv_path, "episode", progress_key), partial_key)
+    df = full_episodes(_table(csv_path, "episode", progress_key), partial_key)
     block = max(1, int(np.ceil(len(df) / blocks)))
     starts, edges, shares = ending_shares(df[progress_key].to_numpy(), block)
     fig, ax = plt.subplots(figsize=(9, 5))
@@ -148,7 +154,7 @@ def plot_endings(csv_path: str | Path, png_path: str | Path, title: str, progres
     return _write(fig, png_path)
 
 
-def _full_episodes(df: pd.DataFrame, partial_key: str | None) -> pd.DataFrame:
+def full_episodes(df: pd.DataFrame, partial_key: str | None) -> pd.DataFrame:
     """The rows of episodes that started where evaluations start (not marked by ``partial_key``)."""
     return df[df[partial_key] != 1] if partial_key and partial_key in df else df
 

@@ -165,6 +165,36 @@ def test_plot_of_an_unfinished_mario_run(capsys, tmp_path):
     assert all(Path(p).stat().st_size > 1000 for p in written)
 
 
+def test_mario_plots_leave_out_restarted_episodes(capsys, tmp_path, monkeypatch):
+    """Restarts start at x 2,900: their ends must not show in the endings map or the curves."""
+    import rlcore.plotting as plotting
+    from rlcore.checkpoint import save_checkpoint
+
+    rows = ["episode,total_points,av_latest_points,target_ave_scores,x_pos,success,success_share,restarted"]
+    rows += [f"{i},{5 if i % 2 else 300},0,0,{3000 if i % 2 else 300 + i},0,0,{i % 2}" for i in range(1, 41)]
+    (tmp_path / "metrics.csv").write_text("\n".join(rows) + "\n")
+    save_checkpoint(tmp_path / "checkpoint.npz", {}, {}, {"experiment": "mario_ppo", "algo": "ppo",
+                                                          "preset": "default", "seed": 0,
+                                                          "config": {"window": 20}})
+    ended_at, kept = [], []  # what the endings map and each plot were given
+    ending_shares, full_episodes = plotting.ending_shares, plotting.full_episodes
+
+    def spy_ending_shares(x, *args, **kwargs):
+        ended_at.extend(x)
+        return ending_shares(x, *args, **kwargs)
+
+    def spy_full_episodes(df, key):
+        kept.append(full_episodes(df, key))
+        return kept[-1]
+
+    monkeypatch.setattr(plotting, "ending_shares", spy_ending_shares)
+    monkeypatch.setattr(plotting, "full_episodes", spy_full_episodes)
+    code, _, err = run(capsys, "plot", str(tmp_path))
+    assert code == 0, err
+    assert sorted(ended_at) == [300 + i for i in range(2, 41, 2)]  # the 20 episodes from the start
+    assert len(kept) == 3 and all(len(df) == 20 and (df["restarted"] == 0).all() for df in kept)
+
+
 def test_ending_shares_say_where_each_block_of_episodes_ended():
     from rlcore.plotting import ending_shares
 
