@@ -3,7 +3,7 @@
 Experiments may name an info key that marks success (Mario: ``flag_get``) and one that measures
 progress (Mario: ``x_pos``); the trainer then logs the success of every episode, the share over
 the last ``window`` episodes, and prints one line per rollout with the max and min progress (the
-article's console line).
+article's console line; :class:`RolloutLog`).
 """
 from __future__ import annotations
 
@@ -19,7 +19,8 @@ from rlcore.trainers import checkpoints
 from rlcore.trainers.divergence import reported_divergence
 from rlcore.trainers.session import TrainingSession
 from rlcore.trainers.spec import RunSpec
-from rlcore.vector import EnvPool, final_info
+from rlcore.trainers.rollout_log import RolloutLog
+from rlcore.vector import EnvPool
 
 
 class Rollout:
@@ -52,7 +53,6 @@ def train(spec: RunSpec) -> Path:
     obs_shape, n_actions = envs.single_observation_space.shape, int(envs.single_action_space.n)
     agent = PPOAgent(obs_shape, n_actions, cfg)
     rng = np.random.default_rng(spec.seed)
-    success_key, progress_key, partial_key = exp.success_key, exp.progress_key, exp.partial_key
 
     state, _ = checkpoints.restore(spec, agent, rng)
     if state is not None:
@@ -74,8 +74,7 @@ def train(spec: RunSpec) -> Path:
     obs, _ = envs.reset(seed=session.fresh_env_seeds(n))
     with envs, session.interruptible():
         while not session.should_stop():
-            max_x, min_x, ended, flags = -np.inf, np.inf, 0, 0
-            partial_ended, partial_flags = 0, 0  # episodes that did not start at the start (restarts)
+            log = RolloutLog(exp)
             truncated_values = {}
             for step in range(t):
                 actions, logp, values = agent.act(obs, rng)
@@ -85,50 +84,23 @@ def train(spec: RunSpec) -> Path:
                 buf.rewards[step], buf.terminated[step], buf.dones[step] = rewards, terminated, done
                 session.env_steps += n
                 running += rewards
-                if progress_key:
-                    max_x = max(max_x, float(np.max(infos[progress_key])))
+                log.step(infos)
                 cut = np.flatnonzero(truncated & ~terminated)
                 if len(cut):  # one batched call for every env cut by a time limit this step
                     finals = agent.values(np.stack([infos["final_obs"][i] for i in cut]))
                     truncated_values.update({(step, i): float(v) for i, v in zip(cut, finals)})
                 for i in np.flatnonzero(done):
-                    extra, won = dict(losses), None
-                    partial = bool(partial_key and final_info(infos, partial_key, i, False))
-                    if partial_key:
-                        extra[partial_key] = float(partial)
-                        partial_ended += partial
-                    if progress_key:
-                        x = float(final_info(infos, progress_key, i))
-                        max_x, min_x = max(max_x, x), min(min_x, x)
-                        extra[progress_key] = x
-                    if success_key:
-                        won = bool(final_info(infos, success_key, i, False))
-                        flags += won and not partial
-                        partial_flags += won and partial
-                    for key in exp.info_keys:  # NaN where the env did not report it
-                        extra[key] = float(final_info(infos, key, i, float("nan")))
-                    session.end_episode(running[i], extra, success=won, counted=not partial)
+                    row, won, counted = log.episode(infos, i, losses)
+                    session.end_episode(running[i], row, success=won, counted=counted)
                     running[i] = 0.0
-                    ended += 1
                 obs = next_obs
                 session.advance(n)
             buf.close(agent.values(obs), truncated_values)
             with reported_divergence(session, "PPO", "lower --lr"):
                 losses = agent.update(*buf.arrays(), rng)
             rollouts += 1
-            row = {"episodes_ended": ended, "successes": flags}
-            if partial_key:
-                row.update({f"{partial_key}_episodes": partial_ended, f"{partial_key}_successes": partial_flags})
-            session.log_rollout(rollouts, {**row, f"max_{progress_key or 'x'}": max_x, **losses})
-            line = f"rollout {rollouts} | env steps {session.env_steps:,} | episodes {book.episodes:,}"
-            if progress_key:
-                line += (f" | max {progress_key} {max_x:.0f} | min {progress_key} "
-                         f"{min_x if np.isfinite(min_x) else float('nan'):.0f}")
-            if success_key:
-                line += (f" | {success_key} {flags}/{ended - partial_ended} (last {cfg.window}: "
-                         f"{book.success_share:.0%})")
-                if partial_ended:
-                    line += f" | {partial_key} {partial_flags}/{partial_ended}"
+            session.log_rollout(rollouts, {**log.row(), **losses})
+            line = log.line(rollouts, session.env_steps, book, cfg.window)
             tqdm.write(line + f" | loss {losses['loss']:.3f} entropy {losses['entropy']:.2f}")
             if rollouts % cfg.checkpoint_rollouts == 0:
                 checkpoint()

@@ -80,8 +80,8 @@ def _interrupt_after(episodes, trainer, spec):
     from rlcore.trainers import session as session_mod
     original = session_mod.TrainingSession.end_episode
 
-    def end_episode(self, episode_return, extra, success=None):
-        original(self, episode_return, extra, success)
+    def end_episode(self, *args, **kwargs):
+        original(self, *args, **kwargs)
         if self.book.episodes == episodes:
             self.stop.requested = True
     session_mod.TrainingSession.end_episode = end_episode
