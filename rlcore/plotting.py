@@ -60,9 +60,9 @@ def plot_episode_scores(csv_path: str | Path, png_path: str | Path, title: str,
     Episodes marked by ``partial_key`` (Mario's restarts) are left out, and the average is taken
     over the others."""
     df = _table(csv_path, "episode", "total_points", "av_latest_points")
-    if partial_key and partial_key in df:
-        df = full_episodes(df, partial_key)
-        df = df.assign(av_latest_points=df["total_points"].rolling(100, min_periods=1).mean())
+    full = full_episodes(df, partial_key)
+    if len(full) < len(df):  # the logged average counted every episode: take it over these only
+        df = full.assign(av_latest_points=full["total_points"].rolling(100, min_periods=1).mean())
     fig, ax = plt.subplots(figsize=(9, 5))
     ax.plot(df["episode"], df["total_points"], color="tab:blue", linewidth=1, alpha=0.6, label="Score")
     ax.plot(df["episode"], df["av_latest_points"], color="tab:orange", linewidth=2, linestyle="--",
