@@ -9,7 +9,7 @@ import dataclasses
 from dataclasses import dataclass, field
 
 from mario_ppo.env import ACTION_SETS, FRAME_STACKS, StallLimit, make_env
-from rlcore.allowed import OFF_OR_COUNT, Allowed, choices
+from rlcore.allowed import OFF_OR_COUNT, Allowed, choices, require
 from rlcore.configs import PPOConfig
 from rlcore.experiment import AlgoSpec, Experiment
 
@@ -40,9 +40,18 @@ class MarioPPOConfig(PPOConfig):
         "help": "training only: start a share (--restart-share) of episodes from the state in which an "
                 "earlier episode first passed this x, to practise a hard place far into the level; "
                 "evaluation always starts at the level's start (0 = off)", "allowed": OFF_OR_COUNT})
+    restart_every: int = field(default=0, metadata={
+        "help": "training only: as --restart-x, at every multiple of this x that an earlier episode "
+                "passed, the point drawn uniformly for each restarted episode, for a level whose hard "
+                "places are not known (0 = off)", "allowed": OFF_OR_COUNT})
     restart_share: float = field(default=0.5, metadata={
-        "help": "with --restart-x: the share of training episodes that start there; they are left out "
+        "help": "with --restart-x or --restart-every: the share of training episodes that start there; they are left out "
                 "of the flag share the stop rule reads", "allowed": Allowed(low=0, high=1)})
+
+    def __post_init__(self):
+        super().__post_init__()
+        require(not (self.restart_x and self.restart_every),
+                "--restart-x and --restart-every are two ways to say where restarts start: give one")
 
 
 # Article 001: 8 envs x 512 steps, GAE gamma 0.99 lambda 0.97, clip 0.2, entropy 0.05, Adam 1e-4,
@@ -78,7 +87,7 @@ EXPERIMENT = Experiment(
     algos={"ppo": AlgoSpec("ppo", "ppo", "PPO, 8 envs over Pipes", {"article": ARTICLE, "default": DEFAULT})},
     video_fps=60,
     env_fields=("world", "stage", "actions", "score_reward", "stall_steps", "stall_outcome",
-                "frames", "dead_ends"), train_env_fields=("restart_x", "restart_share"),
+                "frames", "dead_ends"), train_env_fields=("restart_x", "restart_every", "restart_share"),
     success_key="flag_get", progress_key="x_pos", partial_key="restarted",
     info_keys=("stalled",),
     eval_episodes=10, ship_by=("world", "stage"), default_model="1-1", score_label="return (shaped, /10)",

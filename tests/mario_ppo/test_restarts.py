@@ -78,3 +78,36 @@ def test_restarts_reach_the_training_envs_only():
     finally:
         training.close()
         evaluation.close()
+
+
+EVERY = 80  # walking right alone on 1-1 passes x 240 before the first Goomba
+
+
+def test_with_a_spacing_restarts_start_at_every_kept_point_and_restarted_episodes_add_further_ones():
+    env = make_env(restart_every=EVERY, restart_share=1.0)
+    try:
+        env.reset(seed=0)
+        _run_right_past(env, 2 * EVERY)  # passes the points at 80 and 160
+        starts = [env.reset(seed=s)[1]["x_pos"] for s in range(1, 13)]
+        assert {x // EVERY for x in starts} == {1, 2}  # both points drawn, and nothing else
+        assert all(x < 3 * EVERY for x in starts)
+        seed = 20
+        while env.reset(seed=seed)[1]["x_pos"] < 2 * EVERY:  # a restart at the furthest point ...
+            seed += 1
+        _run_right_past(env, 3 * EVERY)  # ... that gets further keeps the next point too
+        later = {env.reset(seed=s)[1]["x_pos"] // EVERY for s in range(30, 50)}
+        assert later == {1, 2, 3}
+    finally:
+        env.close()
+
+
+def test_one_restart_point_or_a_spacing_not_both():
+    import pytest
+
+    from rlcore.errors import UserError
+
+    default = EXPERIMENT.preset("ppo", "default")
+    with pytest.raises(UserError, match="--restart-x and --restart-every"):
+        dataclasses.replace(default, restart_x=X, restart_every=EVERY)
+    with pytest.raises(ValueError):
+        Restarts(make_env().unwrapped, 0.5)
