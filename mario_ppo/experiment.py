@@ -8,7 +8,8 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass, field
 
-from mario_ppo.env import ACTION_SETS, FRAME_STACKS, StallLimit, make_env
+from mario_ppo.env import ACTION_SETS, FRAME_STACKS, make_env
+from mario_ppo.episode_ends import StallLimit
 from rlcore.allowed import OFF_OR_COUNT, Allowed, choices, require
 from rlcore.configs import PPOConfig
 from rlcore.experiment import AlgoSpec, Experiment
