@@ -16,11 +16,17 @@ Evaluation never uses it: both are training-only settings (``Experiment.train_en
 every evaluation and video starts at the level's start. Restarted episodes are marked
 (``info["restarted"]``) and left out of the flag share that the stop rule reads.
 
+A kept point is an emulator state and its route: the buttons, one per NES frame, that lead to it
+from the level's start (through the routes of the restarts it came from). The emulator is
+deterministic, so a checkpoint keeps the routes (``restart_routes``, a few KB each) and a resumed run
+replays them to get its points back; the emulator's own state cannot be written to a file.
+
 TensorFlow-free: env-pool worker processes import this module.
 """
 from __future__ import annotations
 
 import gymnasium as gym
+import numpy as np
 
 
 class Restarts(gym.Wrapper):
@@ -32,8 +38,8 @@ class Restarts(gym.Wrapper):
     or started at, the emulator's state is kept for that point (replacing the one kept before, so the
     points follow the current policy). From then on, each reset loads one kept state with probability
     ``share``, the point drawn uniformly; both draws come from the env's seeded RNG. The kept states
-    live in this env only: a fresh env (a resumed run, say) starts every episode at the level's start
-    until one passes a point again.
+    live in this env; ``restart_routes`` gets and sets them as routes (a resumed run's pool sets what
+    the checkpoint kept).
     """
 
     def __init__(self, env: gym.Env, share: float, x: int = 0, every: int = 0):
@@ -41,9 +47,10 @@ class Restarts(gym.Wrapper):
         if bool(x) == bool(every):
             raise ValueError("give one of x (a single restart point) and every (a spacing)")
         self.x, self.every, self.share = x, every, share
-        self._snapshots: dict[int, object] = {}  # point number -> emulator state
+        self._snapshots: dict[int, tuple[object, bytes]] = {}  # point number -> (emulator state, route)
         self._restarted = False
         self._passed = 0
+        self._route = bytearray()  # this episode's buttons, one per frame, from the level's start
 
     def point(self, x_pos: int) -> int:
         """The number of the furthest restart point at or behind ``x_pos`` (0: none)."""
@@ -54,22 +61,55 @@ class Restarts(gym.Wrapper):
     def reset(self, *, seed=None, options=None):
         obs, info = self.env.reset(seed=seed, options=options)
         self._restarted = bool(self._snapshots) and self.np_random.random() < self.share
+        self._route = bytearray()
         if self._restarted:
             points = sorted(self._snapshots)
+            snapshot, route = self._snapshots[points[self.np_random.integers(len(points))]]
             base = self.env.unwrapped
-            base.load_state(self._snapshots[points[self.np_random.integers(len(points))]])
+            base.load_state(snapshot)
             base._did_reset()  # the env's own "last" counters (time, x, score) from the loaded state
             obs, info = base.screen, base._get_info()
+            self._route = bytearray(route)
         self._passed = self.point(info["x_pos"])
         info["restarted"] = self._restarted
         return obs, info
 
     def step(self, action):
         obs, reward, terminated, truncated, info = self.env.step(action)
+        self._route.append(int(action))
         reached = self.point(info["x_pos"])
         if reached > self._passed:
             if not (terminated or truncated or info.get("is_dying")):
-                self._snapshots[reached] = self.env.unwrapped.dump_state()
+                self._snapshots[reached] = (self.env.unwrapped.dump_state(), bytes(self._route))
             self._passed = reached
         info["restarted"] = self._restarted
         return obs, reward, terminated, truncated, info
+
+    @property
+    def restart_routes(self) -> dict[str, np.ndarray]:
+        """The route (uint8 buttons, one per frame) of each kept point, keyed by its number."""
+        return {str(point): np.frombuffer(route, np.uint8) for point, (_, route) in self._snapshots.items()}
+
+    @restart_routes.setter
+    def restart_routes(self, routes: dict[str, np.ndarray]) -> None:
+        """Keep the points these routes lead to, replayed from the level's start; a route that does
+        not reach its point alive (from another level or button set) is left out. The env must be
+        reset before its next step."""
+        for key, route in routes.items():
+            route = np.asarray(route, np.uint8)
+            snapshot = self._replay(route, int(key))
+            if snapshot is not None:
+                self._snapshots[int(key)] = (snapshot, route.tobytes())
+
+    def _replay(self, route: np.ndarray, point: int):
+        """The emulator state at the end of ``route`` from the level's start, if it is at ``point``
+        and alive; else None."""
+        self.env.reset()
+        info = {"x_pos": -1}
+        for action in route:
+            _, _, terminated, truncated, info = self.env.step(int(action))
+            if terminated or truncated:
+                return None
+        if self.point(info["x_pos"]) != point or info.get("is_dying"):
+            return None
+        return self.env.unwrapped.dump_state()

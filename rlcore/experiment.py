@@ -54,12 +54,16 @@ class Experiment:
     # trainers, and in the evaluation's per-episode records (Mario: stalled, 1 when the stall limit
     # ended it; Minitaur: x, metres walked)
     info_keys: tuple[str, ...] = ()
-    # config fields that make_env takes in training only (Mario: restart_x, restart_share): the
+    # config fields that make_env takes in training only (Mario: restart_x, ...): the
     # trainer's env pool gets them; evaluations, videos and saved models build the env without them
     train_env_fields: tuple[str, ...] = ()
     # an info key that marks an episode that did not start where evaluation starts (Mario: restarted):
     # it trains like any other, but its success is left out of the success share the stop rule reads
     partial_key: str | None = None
+    # an attribute of the training env that it builds up over episodes, a dict of name -> array, which
+    # a checkpoint keeps and a resumed run's env pool gets back (Mario: restart_routes, the buttons that
+    # lead to each kept restart point); ignored when the env has no such attribute
+    env_memory: str | None = None
     # config fields that name a shipped model (Mario: world, stage -> saved_networks/mario_ppo/1-1);
     # empty: one model per algorithm, saved_networks/EXPERIMENT/ALGO
     ship_by: tuple[str, ...] = ()

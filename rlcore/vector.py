@@ -118,6 +118,18 @@ class EnvPool:
             process.join(timeout=5)
         self.envs.closed = True  # Gymnasium's __del__ would try to close it again
 
+    def memory(self, name: str) -> list[dict] | None:
+        """Each env's value of the attribute ``name`` (``Experiment.env_memory``); None when the envs
+        have no such attribute (Mario without restarts)."""
+        if not all(self._guard(lambda: self.envs.call("has_wrapper_attr", name))):
+            return None
+        return list(self._guard(lambda: self.envs.get_attr(name)))
+
+    def give_memory(self, name: str, values: list[dict]) -> None:
+        """Set each env's attribute ``name`` (one value per env), when the envs have it."""
+        if all(self._guard(lambda: self.envs.call("has_wrapper_attr", name))):
+            self._guard(lambda: self.envs.set_attr(name, values))
+
     def worker_pids(self) -> list[int]:
         return [p.pid for p in getattr(self.envs, "processes", [])]
 

@@ -40,15 +40,39 @@ def restore(spec: RunSpec, agent, rng: np.random.Generator,
 
 
 def save(session: TrainingSession, agent, rng: np.random.Generator, memory: ReplayMemory | None = None,
-         **counters) -> None:
+         env_arrays: dict | None = None, **counters) -> None:
     """Write the checkpoint (and the replay memory first, stamped with the same env step count);
-    ``counters``: the trainer's own (epsilon, grad_steps, rollouts, ...)."""
+    ``env_arrays``: what the envs kept (:func:`env_memory`); ``counters``: the trainer's own
+    (epsilon, grad_steps, rollouts, ...)."""
     if memory is not None:
         with atomic_path(session.run_dir / REPLAY_FILE) as tmp, open(tmp, "wb") as f:
             np.savez(f, env_steps=np.array(session.env_steps), **memory.state_dict())
         counters["replay_env_steps"] = session.env_steps
     save_checkpoint(session.checkpoint_path, agent.models(), agent.optimizers(),
-                    session.state(rng=rng.bit_generator.state, **counters), session.best_arrays())
+                    session.state(rng=rng.bit_generator.state, **counters),
+                    {**session.best_arrays(), **(env_arrays or {})})
+
+
+def env_memory(envs, name: str | None) -> dict:
+    """What each env of the pool built up (``Experiment.env_memory``), as checkpoint arrays
+    ``env/<i>/<key>``; empty when the experiment declares none or the envs do not have it."""
+    kept = envs.memory(name) if name else None
+    return {f"env/{i}/{key}": np.asarray(value) for i, values in enumerate(kept or [])
+            for key, value in values.items()}
+
+
+def give_env_memory(envs, name: str | None, arrays: dict) -> None:
+    """Hand each env of a resumed run what it had built up (:func:`env_memory`'s arrays)."""
+    if not name:
+        return
+    per_env = [{} for _ in range(envs.num_envs)]
+    for key, value in arrays.items():
+        if key.startswith("env/"):
+            _, i, inner = key.split("/", 2)
+            if int(i) < envs.num_envs:
+                per_env[int(i)][inner] = value
+    if any(per_env):
+        envs.give_memory(name, per_env)
 
 
 def _restore_replay(run_dir: Path, state: dict, arrays: dict, memory: ReplayMemory) -> None:

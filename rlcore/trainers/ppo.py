@@ -54,9 +54,10 @@ def train(spec: RunSpec) -> Path:
     agent = PPOAgent(obs_shape, n_actions, cfg)
     rng = np.random.default_rng(spec.seed)
 
-    state, _ = checkpoints.restore(spec, agent, rng)
+    state, arrays = checkpoints.restore(spec, agent, rng)
     if state is not None:
         parent = state.get("init_from")
+        checkpoints.give_env_memory(envs, exp.env_memory, arrays)  # Mario: the restart points
     else:
         parent = init_weights(agent, cfg.init_from, exp.name, spec.algo) if cfg.init_from else None
     session = TrainingSession(spec, state, progress_unit="step")
@@ -64,7 +65,8 @@ def train(spec: RunSpec) -> Path:
     rollouts = int(state.get("rollouts", 0)) if state else 0
 
     def checkpoint():
-        checkpoints.save(session, agent, rng, rollouts=rollouts, init_from=parent)
+        checkpoints.save(session, agent, rng, env_arrays=checkpoints.env_memory(envs, exp.env_memory),
+                         rollouts=rollouts, init_from=parent)
 
     t, n = cfg.n_steps, cfg.num_envs
     buf = Rollout(t, n, obs_shape)

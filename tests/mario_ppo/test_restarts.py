@@ -111,3 +111,48 @@ def test_one_restart_point_or_a_spacing_not_both():
         dataclasses.replace(default, restart_x=X, restart_every=EVERY)
     with pytest.raises(ValueError):
         Restarts(make_env().unwrapped, 0.5)
+
+
+def test_a_fresh_env_given_the_kept_routes_restarts_where_the_first_one_did():
+    first, second = (make_env(restart_every=EVERY, restart_share=1.0) for _ in range(2))
+    try:
+        first.reset(seed=0)
+        _run_right_past(first, 2 * EVERY)
+        seed = 10
+        while first.reset(seed=seed)[1]["x_pos"] < 2 * EVERY:  # a restarted episode goes further:
+            seed += 1
+        _run_right_past(first, 3 * EVERY)  # point 3's route runs through point 2's
+        routes = first.get_wrapper_attr("restart_routes")
+        assert sorted(routes) == ["1", "2", "3"] and all(r.dtype == np.uint8 for r in routes.values())
+        second.set_wrapper_attr("restart_routes", routes)  # what a resumed run's pool does
+        for seed in range(1, 7):  # the same seeded draws load the same places, screen for screen
+            a_obs, a_info = first.reset(seed=seed)
+            b_obs, b_info = second.reset(seed=seed)
+            assert b_info["restarted"] and b_info["x_pos"] == a_info["x_pos"]
+            assert np.array_equal(a_obs, b_obs)
+        broken = {"2": routes["2"][: len(routes["2"]) // 2]}  # stops short of its point: left out
+        third = make_env(restart_every=EVERY, restart_share=1.0)
+        third.set_wrapper_attr("restart_routes", broken)
+        assert third.get_wrapper_attr("restart_routes") == {}
+        third.close()
+    finally:
+        first.close()
+        second.close()
+
+
+def test_a_pool_of_processes_hands_the_routes_out_and_back():
+    from rlcore.trainers import checkpoints
+    from rlcore.vector import EnvPool
+
+    cfg = dataclasses.replace(EXPERIMENT.preset("ppo", "default"), restart_every=EVERY, restart_share=1.0)
+    factory = EXPERIMENT.training_env_factory(cfg)
+    with EnvPool([factory] * 2, mode="processes") as envs:
+        envs.reset(seed=[0, 1])
+        for _ in range(60):  # 240 frames of `right`: both envs pass x 160 (and die nowhere)
+            envs.step(np.full(2, RIGHT))
+        arrays = checkpoints.env_memory(envs, EXPERIMENT.env_memory)
+    assert {"env/0/1", "env/0/2", "env/1/1", "env/1/2"} <= set(arrays)
+    with EnvPool([factory] * 2, mode="processes") as resumed:
+        checkpoints.give_env_memory(resumed, EXPERIMENT.env_memory, arrays)
+        _, infos = resumed.reset(seed=[5, 6])
+        assert infos["restarted"].all() and (infos["x_pos"] >= EVERY).all()

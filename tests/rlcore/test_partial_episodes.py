@@ -65,3 +65,52 @@ def test_an_episode_not_counted_logs_its_success_but_leaves_the_share():
     assert book.successes == [False, True] and book.success_share == 0.5
     assert [r["success_share"] for r in rows] == [0.0, 0.0, 0.5, 0.5]
     assert np.isclose(book.average, 1.0) and book.episodes == 4  # returns count every episode
+
+
+class RememberingEnv(toy.ImageSignEnv):
+    """Builds up a memory over its episodes (as Mario's restart points): the episode count."""
+    given: list = []  # every memory a pool handed to one of these envs (inline pools: same process)
+
+    def __init__(self, max_episode_steps=10, render_mode=None):
+        super().__init__(max_episode_steps, render_mode)
+        self.episodes = 0
+
+    def reset(self, *, seed=None, options=None):
+        self.episodes += 1
+        return super().reset(seed=seed, options=options)
+
+    @property
+    def memory(self) -> dict:
+        return {"episodes": np.array([self.episodes])}
+
+    @memory.setter
+    def memory(self, value: dict) -> None:
+        RememberingEnv.given.append(int(value["episodes"][0]))
+        self.episodes = int(value["episodes"][0])
+
+
+def test_a_checkpoint_keeps_what_each_env_built_up_and_a_resume_hands_it_back(tmp_path):
+    from rlcore.trainers.spec import CHECKPOINT_FILE
+
+    spec = toy.spec("ppo", tmp_path, max_episodes=12, stop_success_share=0.0)
+    spec.experiment = dataclasses.replace(
+        spec.experiment, make_env=lambda render_mode=None, max_episode_steps=10:
+        RememberingEnv(max_episode_steps, render_mode), env_memory="memory")
+    RememberingEnv.given.clear()
+    ppo_trainer.train(spec)
+    with np.load(spec.run_dir / CHECKPOINT_FILE) as saved:
+        kept = sorted(int(saved[f"array/env/{i}/episodes"][0]) for i in range(2))
+    assert sum(kept) >= 12 and RememberingEnv.given == []  # a new run starts with nothing handed over
+    spec.resume = True
+    spec.config = dataclasses.replace(spec.config, max_episodes=24)
+    ppo_trainer.train(spec)
+    assert sorted(RememberingEnv.given) == kept
+
+
+def test_envs_without_the_declared_memory_keep_nothing():
+    from rlcore.trainers import checkpoints
+    from rlcore.vector import EnvPool
+
+    with EnvPool([toy.make_image_env] * 2) as envs:
+        assert checkpoints.env_memory(envs, "memory") == {} and checkpoints.env_memory(envs, None) == {}
+        checkpoints.give_env_memory(envs, "memory", {"env/0/episodes": np.array([3])})  # no error
