@@ -15,9 +15,12 @@ class EpisodeBook:
     """Episode returns, the moving average, successes, and the article's console line and wandb keys."""
 
     def __init__(self, window: int, solved_score: float | None, returns: list[float] | None = None,
-                 successes: list[bool] | None = None):
+                 successes: list[bool] | None = None, counted_returns: list[float] | None = None):
         self.window, self.solved_score = window, solved_score
-        self.returns: list[float] = list(returns or [])
+        self.returns: list[float] = list(returns or [])  # every episode's, in order
+        # the returns of the episodes that count (all but those that started elsewhere than
+        # evaluations do, e.g. Mario's restarts): the moving average is theirs
+        self.counted_returns: list[float] = list(self.returns if counted_returns is None else counted_returns)
         self.successes: list[bool] = list(successes or [])  # only counted episodes that report success
         self.solved_episode: int | None = None
 
@@ -27,7 +30,9 @@ class EpisodeBook:
 
     @property
     def average(self) -> float:
-        return float(np.mean(self.returns[-self.window:])) if self.returns else float("nan")
+        """The mean return of the last ``window`` counted episodes."""
+        recent = self.counted_returns[-self.window:]
+        return float(np.mean(recent)) if recent else float("nan")
 
     @property
     def success_share(self) -> float:
@@ -36,20 +41,23 @@ class EpisodeBook:
         return float(np.mean(recent)) if recent else 0.0
 
     def full_window(self) -> bool:
-        return len(self.returns) >= self.window
+        return len(self.counted_returns) >= self.window
 
     def add(self, episode_return: float, success: bool | None = None, counted: bool = True) -> dict:
         """Record one episode; return the article's per-episode metrics (and success, when given).
-        An episode not ``counted`` (it started elsewhere than evaluations do) logs its success but
-        leaves the success share as it was."""
+        An episode not ``counted`` (it started elsewhere than evaluations do) logs its return and
+        success but leaves the moving average and the success share as they were."""
         self.returns.append(float(episode_return))
+        if counted:
+            self.counted_returns.append(float(episode_return))
         if (self.solved_score is not None and self.solved_episode is None and self.full_window()
                 and self.average >= self.solved_score):
             self.solved_episode = self.episodes
             tqdm.write(f"\nEnvironment solved in {self.episodes} episodes!")
         if self.episodes % self.window == 0:
+            which = "episodes" if len(self.counted_returns) == self.episodes else "full episodes"
             tqdm.write(f"Episode {self.episodes} | Total point average of the last {self.window} "
-                       f"episodes: {self.average:.2f}")
+                       f"{which}: {self.average:.2f}")
         row = {"episode": self.episodes, "total_points": float(episode_return),
                "av_latest_points": self.average, "target_ave_scores": self.solved_score}
         if success is not None:

@@ -46,7 +46,7 @@ class TrainingSession:
         writable_folder(self.run_dir, "run folder")
         state = resumed_state or {}
         self.book = EpisodeBook(cfg.window, spec.experiment.solved_score, state.get("returns"),
-                                state.get("successes"))
+                                state.get("successes"), state.get("counted_returns"))
         self.book.solved_episode = state.get("solved_episode")
         self.env_steps = int(state.get("env_steps", 0))
         self._wall_before, self._started = float(state.get("wall_seconds", 0.0)), time.perf_counter()
@@ -125,6 +125,9 @@ class TrainingSession:
     def state(self, **extra) -> dict:
         """JSON-able counters for a checkpoint (``extra``: the trainer's own)."""
         return {**self.spec.describe(), "returns": self.book.returns, "successes": self.book.successes,
+                # only when some episodes did not count (Mario's restarts); else the returns are they
+                "counted_returns": (self.book.counted_returns
+                                    if len(self.book.counted_returns) != self.book.episodes else None),
                 "solved_episode": self.book.solved_episode, "env_steps": self.env_steps,
                 "wall_seconds": self.elapsed(), "wandb_id": self.tracker.wandb_id,
                 **self.evaluation.state(), "commands": self.commands, **extra}

@@ -55,16 +55,34 @@ def test_partial_episodes_train_and_are_logged_but_not_counted_toward_the_succes
     rollouts = pd.read_csv(spec.run_dir / "rollouts.csv")
     assert rollouts["partial_episodes"].sum() == rows["partial"].sum()
     assert rollouts["partial_successes"].sum() == rows["partial"].sum() and rollouts["successes"].sum() == 0
+    # the checkpoint keeps the counted episodes' returns apart, for the moving average of a resumed run
+    from rlcore.checkpoint import read_checkpoint_state
+    from rlcore.trainers.spec import CHECKPOINT_FILE
+    state = read_checkpoint_state(spec.run_dir / CHECKPOINT_FILE)
+    full = rows.loc[rows["partial"] == 0, "total_points"]
+    assert np.allclose(state["counted_returns"], full) and len(state["returns"]) == len(rows)
+    assert np.isclose(rows["av_latest_points"].iloc[-1], full.iloc[-spec.config.window:].mean())
+    before = len(rows)
+    spec.resume, spec.config = True, dataclasses.replace(spec.config, max_episodes=before + 4)
+    ppo_trainer.train(spec)  # a resumed run's first episodes still average the counted ones only
+    rows = pd.read_csv(spec.run_dir / "metrics.csv")
+    first = rows.index[rows["episode"] > before][0]
+    full = rows.loc[: first].query("partial == 0")["total_points"]
+    assert np.isclose(rows["av_latest_points"].iloc[first], full.iloc[-spec.config.window:].mean())
 
 
 def test_an_episode_not_counted_logs_its_success_but_leaves_the_share():
     book = EpisodeBook(window=4, solved_score=None)
-    rows = [book.add(1.0, success=s, counted=c)
-            for s, c in [(False, True), (True, False), (True, True), (True, False)]]
+    rows = [book.add(r, success=s, counted=c)
+            for r, s, c in [(1.0, False, True), (10.0, True, False), (3.0, True, True), (20.0, True, False)]]
     assert [r["success"] for r in rows] == [0, 1, 1, 1]
     assert book.successes == [False, True] and book.success_share == 0.5
     assert [r["success_share"] for r in rows] == [0.0, 0.0, 0.5, 0.5]
-    assert np.isclose(book.average, 1.0) and book.episodes == 4  # returns count every episode
+    # every episode is numbered and keeps its return; the moving average is the counted ones'
+    assert book.episodes == 4 and book.returns == [1.0, 10.0, 3.0, 20.0]
+    assert [r["av_latest_points"] for r in rows] == [1.0, 1.0, 2.0, 2.0]
+    resumed = EpisodeBook(4, None, book.returns, book.successes, book.counted_returns)
+    assert resumed.average == 2.0 and EpisodeBook(4, None, [1.0, 3.0]).average == 2.0
 
 
 class RememberingEnv(toy.ImageSignEnv):
