@@ -245,12 +245,18 @@ def cmd_sweep(args) -> int:
 
 
 def cmd_report(args) -> int:
-    from rlcore.report import markdown, plot_curves, summarize
+    from rlcore.report import keep, markdown, plot_curves, summarize
 
-    result = summarize([Path(d) for d in args.sweep_dirs], reps=args.reps)
+    folders = [Path(d) for d in args.sweep_dirs]
+    if args.keep:
+        if len(folders) != 1:
+            raise UserError("--keep copies one sweep: give one SWEEP_DIR with it")
+        folders = [keep(folders[0], Path(args.keep))]
+        print(f"kept: {folders[0]} (sweep.json; per run model/meta.json, metrics.csv, evals.csv)")
+    result = summarize(folders, reps=args.reps)
     text = markdown(result)
     print(text)
-    first = Path(args.sweep_dirs[0])
+    first = folders[0]
     from rlcore.atomic import write_atomic
     write_atomic(first / "report.md", lambda p: p.write_text(text + "\n"))
     png = plot_curves(result, first / "report_curves.png")
@@ -363,6 +369,10 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
                                         "report.md and report_curves.png into the first sweep folder.")
     report.add_argument("sweep_dirs", nargs="+", metavar="SWEEP_DIR")
     report.add_argument("--reps", type=whole_number(Allowed(low=100, high=10**6)), default=5000, help="bootstrap resamples")
+    report.add_argument("--keep", metavar="DIR", default=None,
+                        help="first copy what the report reads (sweep.json; per run model/meta.json, metrics.csv, "
+                             "evals.csv; not the checkpoints) into DIR, a folder git keeps such as "
+                             "results/sweeps/NAME, and write the report there")
 
     plot = sub.add_parser("plot", help="write the training plots of a run folder (running, interrupted "
                                        "or finished)",

@@ -14,10 +14,12 @@ from __future__ import annotations
 
 import csv
 import json
+import shutil
 from pathlib import Path
 
 import numpy as np
 
+from rlcore.atomic import write_atomic
 from rlcore.errors import UserError
 
 AGGREGATES = ("mean", "median", "iqm")
@@ -83,6 +85,26 @@ def load_runs(sweep_dir: Path) -> list[dict]:
     if not rows:
         raise UserError(f"{sweep_dir} holds no finished, evaluated run (model/meta.json with an evaluation)")
     return rows
+
+
+#: what the report reads of a run folder; ``keep`` copies these (a sweep's checkpoints stay behind)
+KEPT_FILES = ("model/meta.json", "metrics.csv", "evals.csv")
+
+
+def keep(sweep_dir: Path, dest: Path) -> Path:
+    """Copy what the report of ``sweep_dir`` reads (``sweep.json``; per run, :data:`KEPT_FILES`)
+    into ``dest``, a folder git keeps (``results/sweeps/NAME``); a report of ``dest`` then gives the
+    same numbers. Returns ``dest``."""
+    sweep_dir, dest = Path(sweep_dir), Path(dest)
+    runs = load_runs(sweep_dir)  # refuses a folder with no finished run before anything is copied
+    copies = [(sweep_dir / "sweep.json", dest / "sweep.json")] if (sweep_dir / "sweep.json").is_file() else []
+    for run in runs:
+        copies += [(run["run_dir"] / name, dest / run["trial"] / name) for name in KEPT_FILES
+                   if (run["run_dir"] / name).is_file()]
+    for source, target in copies:
+        target.parent.mkdir(parents=True, exist_ok=True)
+        write_atomic(target, lambda tmp, source=source: shutil.copyfile(source, tmp))
+    return dest
 
 
 def run_curve(run_dir: Path) -> tuple[np.ndarray, np.ndarray]:

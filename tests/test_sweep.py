@@ -195,3 +195,29 @@ def test_report_groups_a_grid_sweep_by_setting(tmp_path):
     assert "P(grid [lr=0.001] > grid [lr=0.01]) = 0.000" in text
     lo, hi = first["median"][1:]
     assert f"| median | 487.000 | [{lo:.3f}, {hi:.3f}] |" in text and "| mean | 380.400 |" in text
+
+
+def test_report_keep_copies_what_the_report_reads_and_nothing_else(tmp_path, capsys):
+    sweep, kept = tmp_path / "sweeps" / "toy__dqn", tmp_path / "results" / "toy__dqn"
+    (sweep).mkdir(parents=True)
+    (sweep / "sweep.json").write_text(json.dumps({"experiment": "toy"}))
+    for seed, score in enumerate((100.0, 250.0, 300.0)):
+        run_dir = sweep / f"seed={seed}"
+        (run_dir / "model").mkdir(parents=True)
+        (run_dir / "model" / "meta.json").write_text(json.dumps({
+            "seed": seed, "env_steps": 1000 * (seed + 1), "wall_seconds": 2.0, "evaluation": {"episodes": 5, "mean": score}}))
+        (run_dir / "metrics.csv").write_text("episode,env_steps,av_latest_points\n1,10,1.0\n2,1000,%s\n" % score)
+        (run_dir / "evals.csv").write_text("env_steps,mean\n1000,%s\n" % score)
+        (run_dir / "checkpoint.npz").write_bytes(b"large")
+    code, out, err = run(capsys, "report", str(sweep), "--keep", str(kept), "--reps", "200")
+    assert code == 0, err
+    copied = sorted(str(p.relative_to(kept)) for p in kept.rglob("*") if p.is_file())
+    per_run = ["evals.csv", "metrics.csv", "model/meta.json"]
+    assert copied == sorted(["report.md", "report_curves.png", "sweep.json"]
+                            + [f"seed={s}/{name}" for s in range(3) for name in per_run])
+    assert not (sweep / "report.md").exists()  # the report is written where the copies are
+    again = summarize([kept], reps=200)
+    assert again["sweeps"][0]["aggregates"]["mean"][0] == pytest.approx(650.0 / 3)
+    assert [r["env_steps"] for r in load_runs(kept)] == [1000, 2000, 3000]
+    code, _, err = run(capsys, "report", str(sweep), str(kept), "--keep", str(tmp_path / "other"))
+    assert code == 2 and "--keep copies one sweep" in err and not (tmp_path / "other").exists()
