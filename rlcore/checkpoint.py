@@ -16,7 +16,8 @@ from rlcore.errors import UserError
 def save_checkpoint(path: str | Path, models: dict, optimizers: dict, state: dict,
                     arrays: dict[str, np.ndarray] | None = None) -> Path:
     """Write Keras ``models`` and ``optimizers`` (by name), a JSON-able ``state`` and extra ``arrays``."""
-    payload = {"state_json": np.array(json.dumps(state, default=str))}
+    # UTF-8 bytes: a numpy string array would hold 4 bytes per character (Mario's episode list: MBs)
+    payload = {"state_json": np.frombuffer(json.dumps(state, default=str).encode(), np.uint8)}
     for name, model in models.items():
         for i, w in enumerate(model.get_weights()):
             payload[f"model/{name}/{i}"] = w
@@ -39,7 +40,9 @@ def read_checkpoint_state(path: str | Path) -> dict:
         raise UserError(f"no checkpoint at {path}; nothing to resume")
     try:
         with np.load(path) as data:
-            return json.loads(str(data["state_json"]))
+            text = data["state_json"]
+            # checkpoints written before 2026-11-24 hold the JSON as a numpy string
+            return json.loads(text.tobytes().decode() if text.dtype == np.uint8 else str(text))
     except Exception as exc:
         raise UserError(f"checkpoint {path} is damaged or not one of ours ({type(exc).__name__})")
 

@@ -1,5 +1,6 @@
 """Atomic writes, checkpoints, hyperparameter parsing, tracking (wandb offline) and MP4 output."""
 import dataclasses
+import json
 import os
 import signal
 import subprocess
@@ -159,3 +160,17 @@ def test_tracker_drops_rows_logged_after_a_checkpoint(tmp_path):
     assert (tmp_path / "rollouts.csv").read_text().splitlines()[-1] == "2,20"
     assert (tmp_path / "notes.csv").read_text() == "a,b\n1,2\n"
     assert tracker.drop_rows_after(20) == {}
+
+
+def test_the_checkpoint_state_is_utf8_and_older_checkpoints_still_read(tmp_path):
+    from rlcore.checkpoint import read_checkpoint_state
+
+    state = {"returns": [1.5] * 1000, "name": "Mario 2-1 – ünïcode"}
+    path = save_checkpoint(tmp_path / "new.npz", {}, {}, state)
+    with np.load(path) as data:
+        assert data["state_json"].dtype == np.uint8  # 1 byte per character, not a numpy string's 4
+        assert data["state_json"].nbytes < 1.1 * len(json.dumps(state, ensure_ascii=False).encode())
+    assert read_checkpoint_state(path) == state
+    old = tmp_path / "old.npz"  # as written before: the JSON as a numpy string array
+    np.savez(old, state_json=np.array(json.dumps(state)))
+    assert read_checkpoint_state(old) == state
