@@ -121,6 +121,8 @@ class EnvPool:
     def memory(self, name: str) -> list[dict] | None:
         """Each env's value of the attribute ``name`` (``Experiment.env_memory``); None when the envs
         have no such attribute (Mario without restarts)."""
+        if self.closed:
+            raise RuntimeError("the env pool is closed: read its envs' memory before closing it")
         if not all(self._guard(lambda: self.envs.call("has_wrapper_attr", name))):
             return None
         return list(self._guard(lambda: self.envs.get_attr(name)))

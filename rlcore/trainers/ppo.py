@@ -64,9 +64,10 @@ def train(spec: RunSpec) -> Path:
     book = session.book
     rollouts = int(state.get("rollouts", 0)) if state else 0
 
+    env_kept = {}  # what the envs built up (Mario: the restart routes), read while the pool is open
+
     def checkpoint():
-        checkpoints.save(session, agent, rng, env_arrays=checkpoints.env_memory(envs, exp.env_memory),
-                         rollouts=rollouts, init_from=parent)
+        checkpoints.save(session, agent, rng, env_arrays=env_kept, rollouts=rollouts, init_from=parent)
 
     t, n = cfg.n_steps, cfg.num_envs
     buf = Rollout(t, n, obs_shape)
@@ -105,7 +106,9 @@ def train(spec: RunSpec) -> Path:
             line = log.line(rollouts, session.env_steps, book, cfg.window)
             tqdm.write(line + f" | loss {losses['loss']:.3f} entropy {losses['entropy']:.2f}")
             if rollouts % cfg.checkpoint_rollouts == 0:
+                env_kept = checkpoints.env_memory(envs, exp.env_memory)
                 checkpoint()
+        env_kept = checkpoints.env_memory(envs, exp.env_memory)  # for the last checkpoint, after the pool closes
     # the model's story starts with the run whose weights it started from
     return session.conclude(checkpoint, agent.save, **({"init_from": parent} if parent else {}))
 

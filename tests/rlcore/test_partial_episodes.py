@@ -118,7 +118,9 @@ def test_a_checkpoint_keeps_what_each_env_built_up_and_a_resume_hands_it_back(tm
     ppo_trainer.train(spec)
     with np.load(spec.run_dir / CHECKPOINT_FILE) as saved:
         kept = sorted(int(saved[f"array/env/{i}/episodes"][0]) for i in range(2))
-    assert sum(kept) >= 12 and RememberingEnv.given == []  # a new run starts with nothing handed over
+    ended = len(pd.read_csv(spec.run_dir / "metrics.csv"))
+    assert sum(kept) == ended + 2  # as the envs stood at the end: every episode (+ the one each began)
+    assert RememberingEnv.given == []  # a new run starts with nothing handed over
     spec.resume = True
     spec.config = dataclasses.replace(spec.config, max_episodes=24)
     ppo_trainer.train(spec)
