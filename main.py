@@ -370,8 +370,8 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
     report.add_argument("sweep_dirs", nargs="+", metavar="SWEEP_DIR")
     report.add_argument("--reps", type=whole_number(Allowed(low=100, high=10**6)), default=5000, help="bootstrap resamples")
     report.add_argument("--keep", metavar="DIR", default=None,
-                        help="first copy what the report reads (sweep.json; per run model/meta.json, metrics.csv, "
-                             "evals.csv; not the checkpoints) into DIR, a folder git keeps such as "
+                        help="first copy sweep.json and, per run, model/meta.json, metrics.csv and evals.csv "
+                             "(not the checkpoints) into DIR, a folder git keeps such as "
                              "results/sweeps/NAME, and write the report there")
 
     plot = sub.add_parser("plot", help="write the training plots of a run folder (running, interrupted "

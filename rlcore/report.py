@@ -87,12 +87,13 @@ def load_runs(sweep_dir: Path) -> list[dict]:
     return rows
 
 
-#: what the report reads of a run folder; ``keep`` copies these (a sweep's checkpoints stay behind)
+#: what ``keep`` copies of a run folder: what the report reads (meta.json, metrics.csv) and the periodic
+#: evaluations (evals.csv); a sweep's checkpoints stay behind
 KEPT_FILES = ("model/meta.json", "metrics.csv", "evals.csv")
 
 
 def keep(sweep_dir: Path, dest: Path) -> Path:
-    """Copy what the report of ``sweep_dir`` reads (``sweep.json``; per run, :data:`KEPT_FILES`)
+    """Copy ``sweep.json`` and, per run, :data:`KEPT_FILES` of ``sweep_dir``
     into ``dest``, a folder git keeps (``results/sweeps/NAME``); a report of ``dest`` then gives the
     same numbers. Returns ``dest``."""
     sweep_dir, dest = Path(sweep_dir), Path(dest)

@@ -125,7 +125,7 @@ class TrainingSession:
     def state(self, **extra) -> dict:
         """JSON-able counters for a checkpoint (``extra``: the trainer's own)."""
         return {**self.spec.describe(), "returns": self.book.returns, "successes": self.book.successes,
-                # only when some episodes did not count (Mario's restarts); else the returns are they
+                # only when some episodes did not count (Mario's restarts); else they are the returns
                 "counted_returns": (self.book.counted_returns
                                     if len(self.book.counted_returns) != self.book.episodes else None),
                 "solved_episode": self.book.solved_episode, "env_steps": self.env_steps,
