@@ -108,7 +108,8 @@ def train(spec: RunSpec) -> Path:
             if rollouts % cfg.checkpoint_rollouts == 0:
                 env_kept = checkpoints.env_memory(envs, exp.env_memory)
                 checkpoint()
-        env_kept = checkpoints.env_memory(envs, exp.env_memory)  # for the last checkpoint, after the pool closes
+        env_kept = checkpoints.env_memory(envs, exp.env_memory)  # the last checkpoint is written after the pool
+        # closes (session.conclude), so its reading is taken here, while the pool still answers
     # the model's story starts with the run whose weights it started from
     return session.conclude(checkpoint, agent.save, **({"init_from": parent} if parent else {}))
 

@@ -134,3 +134,27 @@ def test_envs_without_the_declared_memory_keep_nothing():
     with EnvPool([toy.make_image_env] * 2) as envs:
         assert checkpoints.env_memory(envs, "memory") == {} and checkpoints.env_memory(envs, None) == {}
         checkpoints.give_env_memory(envs, "memory", {"env/0/episodes": np.array([3])})  # no error
+
+
+@pytest.mark.parametrize("every", [1, 1000])  # a checkpoint after every rollout; only the last one
+def test_every_checkpoint_keeps_the_env_memory_as_it_stood_then(tmp_path, monkeypatch, every):
+    """Each checkpoint, periodic or the last, holds what the envs had built up when it was written,
+    not an older reading (a run killed after a periodic checkpoint resumes from that one)."""
+    from rlcore.trainers import checkpoints
+
+    spec = toy.spec("ppo", tmp_path, max_episodes=12, stop_success_share=0.0, checkpoint_rollouts=every)
+    spec.experiment = dataclasses.replace(
+        spec.experiment, make_env=lambda render_mode=None, max_episode_steps=10:
+        RememberingEnv(max_episode_steps, render_mode), env_memory="memory")
+    seen, save = [], checkpoints.save
+
+    def spy(session, *args, env_arrays=None, **kwargs):
+        kept = sum(int(env_arrays[f"env/{i}/episodes"][0]) for i in range(2)) if env_arrays else 0
+        seen.append((kept, session.book.episodes))
+        return save(session, *args, env_arrays=env_arrays, **kwargs)
+
+    monkeypatch.setattr(checkpoints, "save", spy)
+    ppo_trainer.train(spec)
+    assert len(seen) >= (2 if every == 1 else 1)
+    # every episode that had ended by then, plus the one each of the 2 envs had begun
+    assert all(kept == ended + 2 for kept, ended in seen), seen
