@@ -25,6 +25,7 @@ from rlcore import allowed  # noqa: E402
 from rlcore.allowed import Allowed, whole_number  # noqa: E402
 from rlcore.seeding import MAX_RUN_SEED  # noqa: E402
 from rlcore.errors import UserError  # noqa: E402
+from mario_ppo.levels import STAGE, WORLD  # noqa: E402  (TF-free)
 from rlcore.atomic import writable_folder  # noqa: E402  (TF-free)
 
 # ---------------------------------------------------------------- commands
@@ -318,10 +319,10 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
         p.add_argument("--model", default=None,
                        help="model folder, a finished run's folder, or a run in progress (its last "
                             "checkpoint) (default saved_networks/EXPERIMENT/ALGO)")
-        p.add_argument("--world", type=int, default=None, help="Mario: the shipped model of this world "
-                       "(default 1)")
-        p.add_argument("--stage", type=int, default=None, help="Mario: the shipped model of this stage "
-                       "(default 1)")
+        p.add_argument("--world", type=whole_number(WORLD), default=None,
+                       help="Mario: the shipped model of this world (default 1)")
+        p.add_argument("--stage", type=whole_number(STAGE), default=None,
+                       help="Mario: the shipped model of this stage (default 1)")
         if name == "evaluate":
             p.add_argument("--episodes", type=COUNT, default=None, help="default 100; Mario 10")
             p.add_argument("--seed-base", type=NON_NEGATIVE, default=None,

@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 
 from mario_ppo.env import ACTION_SETS, FRAME_STACKS, make_env
 from mario_ppo.episode_ends import StallLimit
+from mario_ppo.levels import STAGE, WORLD
 from rlcore.allowed import OFF_OR_COUNT, Allowed, choices, require
 from rlcore.configs import PPOConfig
 from rlcore.experiment import AlgoSpec, Experiment
@@ -17,8 +18,8 @@ from rlcore.experiment import AlgoSpec, Experiment
 
 @dataclass(frozen=True)
 class MarioPPOConfig(PPOConfig):
-    world: int = field(default=1, metadata={"help": "world", "allowed": Allowed(low=1, high=8)})
-    stage: int = field(default=1, metadata={"help": "stage", "allowed": Allowed(low=1, high=4)})
+    world: int = field(default=1, metadata={"help": "world", "allowed": WORLD})
+    stage: int = field(default=1, metadata={"help": "stage", "allowed": STAGE})
     actions: str = field(default="simple", metadata={"help": "button set: 7, 12 or 5 actions",
                                                      "allowed": choices(*ACTION_SETS)})
     score_reward: float = field(default=0.0, metadata={

@@ -82,8 +82,13 @@ def load_runs(sweep_dir: Path) -> list[dict]:
         rows.append({"trial": meta_path.parent.parent.name, "seed": meta["seed"], "score": float(score),
                      "eval_episodes": ev.get("episodes"), "env_steps": meta["env_steps"],
                      "wall_seconds": meta["wall_seconds"], "run_dir": meta_path.parent.parent})
+        rows[-1]["what"] = f"{meta.get('experiment')} {meta.get('algo')}"
     if not rows:
         raise UserError(f"{sweep_dir} holds no finished, evaluated run (model/meta.json with an evaluation)")
+    kinds = sorted({row["what"] for row in rows})
+    if len(kinds) > 1:  # one aggregate over unlike scores would mean nothing
+        raise UserError(f"{sweep_dir} holds runs of {' and '.join(kinds)}: a report aggregates one experiment "
+                        f"and algorithm per folder; give each its own SWEEP_DIR")
     return rows
 
 

@@ -50,6 +50,10 @@ def dqn_model_dir(tmp_path):
                                                                         "shipped levels: "),
     (["render", "lunar_lander", "dqn", "--world", "1"], "--world/--stage choose a Mario level"),
     (["evaluate", "mario_ppo", "ppo", "--world", "1", "--model", "x"], "either --model or --world/--stage"),
+    (["evaluate", "mario_ppo", "ppo", "--stage", "0"], "argument --stage: 0 is invalid: allowed is a number "
+                                                       "from 1 to 4"),
+    (["render", "mario_ppo", "ppo", "--world", "9"], "argument --world: 9 is invalid: allowed is a number "
+                                                     "from 1 to 8"),
 ])
 def test_bad_input_is_one_line_and_exit_2(capsys, argv, message):
     code, out, err = run(capsys, *argv)

@@ -221,3 +221,19 @@ def test_report_keep_copies_what_the_report_reads_and_nothing_else(tmp_path, cap
     assert [r["env_steps"] for r in load_runs(kept)] == [1000, 2000, 3000]
     code, _, err = run(capsys, "report", str(sweep), str(kept), "--keep", str(tmp_path / "other"))
     assert code == 2 and "--keep copies one sweep" in err and not (tmp_path / "other").exists()
+
+
+def test_report_refuses_a_folder_that_mixes_experiments_or_algorithms(tmp_path, capsys):
+    """`report runs/` over a user's runs of unlike tasks would average unlike scores: one line, exit 2."""
+    for name, experiment, algo, score in (("a", "lunar_lander", "dqn", 200.0), ("b", "cartpole", "a2c", 500.0),
+                                          ("c", "lunar_lander", "dqn", 250.0)):
+        (tmp_path / "runs" / name / "model").mkdir(parents=True)
+        (tmp_path / "runs" / name / "model" / "meta.json").write_text(json.dumps({
+            "experiment": experiment, "algo": algo, "seed": 0, "env_steps": 10, "wall_seconds": 1.0,
+            "evaluation": {"episodes": 5, "mean": score}}))
+    code, out, err = run(capsys, "report", str(tmp_path / "runs"))
+    assert code == 2 and len(err.strip().splitlines()) == 1, err
+    assert "holds runs of cartpole a2c and lunar_lander dqn" in err
+    assert not (tmp_path / "runs" / "report.md").exists()
+    (tmp_path / "runs" / "b" / "model" / "meta.json").unlink()  # the rest: one experiment and algorithm
+    assert [r["score"] for r in load_runs(tmp_path / "runs")] == [200.0, 250.0]
