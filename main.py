@@ -273,6 +273,13 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"error: {message} (see `{self.prog} --help`)\n")
 
 
+def folder_name(text: str) -> str:
+    """A sweep's ``--name``: one folder under sweeps/, not a path that leads out of it."""
+    if text.strip() in ("", ".", "..") or any(sep in text for sep in ("/", "\\")):
+        raise argparse.ArgumentTypeError(f"{text!r} is invalid: give a folder name (no '/'), such as lr_grid")
+    return text
+
+
 COUNT, NON_NEGATIVE = whole_number(allowed.COUNT), whole_number(allowed.NON_NEGATIVE)
 SEED = whole_number(Allowed(low=0, high=MAX_RUN_SEED))
 
@@ -359,7 +366,8 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
                        help="CPUs reserved per trial; TensorFlow's threads follow it (default 1)")
     sweep.add_argument("--num-cpus", type=COUNT, default=None,
                        help="CPUs of the local Ray instance (default: all of this machine's)")
-    sweep.add_argument("--name", default=None, help="sweep folder name (default EXPERIMENT__ALGO)")
+    sweep.add_argument("--name", type=folder_name, default=None,
+                       help="sweep folder name, under sweeps/ (default EXPERIMENT__ALGO)")
     sweep.add_argument("--address", default=None,
                        help="join a running Ray cluster (e.g. 10.0.0.5:6379) instead of starting local Ray")
     sweep.add_argument("--resume", action="store_true", help="continue the sweep NAME; finished trials are kept")

@@ -164,12 +164,15 @@ def test_seeds_and_grid_parsing():
     (["sweep", "lunar_lander", "dqn", "--seeds", "4-x"], "--seeds '4-x' is invalid"),
     (["sweep", "lunar_lander", "dqn", "--seeds", "4-0"], "the range 4-0 runs downward; write 0-4"),
     (["report", "/nonexistent/sweep"], "no sweep folder /nonexistent/sweep"),
+    (["sweep", "lunar_lander", "dqn", "--name", "../x"], "argument --name: '../x' is invalid: give a folder name"),
+    (["sweep", "lunar_lander", "dqn", "--name", ".."], "argument --name: '..' is invalid"),
 ])
 def test_bad_sweep_values_are_one_line_and_exit_2(capsys, tmp_path, monkeypatch, argv, message):
     monkeypatch.chdir(tmp_path)
-    code, out, err = run(capsys, *argv, "--name", "x") if argv[0] == "sweep" else run(capsys, *argv)
+    named = argv[0] == "sweep" and "--name" not in argv
+    code, out, err = run(capsys, *argv, "--name", "x") if named else run(capsys, *argv)
     assert code == 2 and message in err and len(err.strip().splitlines()) == 1, err
-    assert not (tmp_path / "sweeps").exists()
+    assert not (tmp_path / "sweeps").exists() and not (tmp_path / "x").exists()
 
 
 def test_report_groups_a_grid_sweep_by_setting(tmp_path):
