@@ -39,7 +39,7 @@ def cmd_list(args) -> int:
             folders = ([shipping.shipped_dir(name, algo)] if not exp.ship_by
                        else sorted((shipping.SAVED_NETWORKS / name).glob("*-*")))
             shipped = [shipping.shipped_summary(f) for f in folders if (f / "meta.json").is_file()]
-            print(f"  {algo:<14} {spec.description:<24} presets: {', '.join(spec.presets):<18} "
+            print(f"  {algo:<14} {spec.description:<24} presets: {', '.join(spec.presets):<25} "
                   f"{'; '.join(shipped) or 'no shipped model'}")
     return 0
 
@@ -297,7 +297,7 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
                                        "overridden; `main.py train EXPERIMENT ALGO --help` lists them.")
     train.add_argument("experiment", help="e.g. lunar_lander")
     train.add_argument("algo", help="e.g. dqn, ddqn, dueling_dqn, dueling_ddqn, a2c")
-    train.add_argument("--preset", default=None, help="article | default (default: default)")
+    train.add_argument("--preset", default=None, help="article | default; Mario also levels (default: default)")
     train.add_argument("--episodes", type=COUNT, default=None, help="episode budget (max_episodes)")
     train.add_argument("--steps", type=COUNT, default=None, help="env step budget (max_env_steps)")
     train.add_argument("--seed", type=SEED, default=0,
@@ -355,7 +355,7 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
     sweep.add_argument("--seeds", default="0-4", help="a range or a list: 0-4, 0,3,7 (default 0-4)")
     sweep.add_argument("--grid", action="append", default=[], metavar="NAME=V1,V2",
                        help="a hyperparameter and its values (repeatable), e.g. --grid lr=1e-4,3e-4")
-    sweep.add_argument("--preset", default=None, help="article | default (default: default)")
+    sweep.add_argument("--preset", default=None, help="article | default; Mario also levels (default: default)")
     sweep.add_argument("--episodes", type=COUNT, default=None, help="episode budget of each run")
     sweep.add_argument("--steps", type=COUNT, default=None, help="env step budget of each run")
     sweep.add_argument("--final-eval-episodes", type=NON_NEGATIVE, default=None,
