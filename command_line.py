@@ -1,0 +1,187 @@
+"""The command line of main.py: one subcommand per mode, and for `train` one flag per hyperparameter
+of the chosen experiment's preset. Every value is checked here, before any run folder exists; a bad
+command line is one line and exit status 2.
+
+TensorFlow-free, so `--help` is quick.
+"""
+from __future__ import annotations
+
+import argparse
+
+from mario_ppo.levels import STAGE, WORLD
+from rlcore import allowed
+from rlcore.allowed import Allowed, whole_number
+from rlcore.seeding import MAX_RUN_SEED
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse that reports a bad command line as one line (and exit status 2)."""
+
+    def error(self, message):
+        self.exit(2, f"error: {message} (see `{self.prog} --help`)\n")
+
+
+def folder_name(text: str) -> str:
+    """A sweep's ``--name``: one folder under sweeps/, not a path that leads out of it."""
+    if text.strip() in ("", ".", "..") or any(sep in text for sep in ("/", "\\")):
+        raise argparse.ArgumentTypeError(f"{text!r} is invalid: give a folder name (no '/'), such as lr_grid")
+    return text
+
+
+COUNT, NON_NEGATIVE = whole_number(allowed.COUNT), whole_number(allowed.NON_NEGATIVE)
+SEED = whole_number(Allowed(low=0, high=MAX_RUN_SEED))
+
+
+def build_parser(argv: list[str]) -> argparse.ArgumentParser:
+    parser = _Parser(
+        prog="main.py", description="TensorFlow 2 / Keras deep RL: train, evaluate and render agents.",
+        epilog="`main.py list` shows experiments, algorithms, presets and shipped models.")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND", parser_class=_Parser)
+
+    sub.add_parser("list", help="experiments, algorithms, presets and shipped models with their scores")
+
+    train = sub.add_parser("train", help="train an agent (Ctrl-C or SIGTERM saves a checkpoint; --resume continues)",
+                           description="Train an agent. Every hyperparameter of the chosen preset can be "
+                                       "overridden; `main.py train EXPERIMENT ALGO --help` lists them.")
+    train.add_argument("experiment", help="e.g. lunar_lander")
+    train.add_argument("algo", help="e.g. dqn, ddqn, dueling_dqn, dueling_ddqn, a2c")
+    train.add_argument("--preset", default=None, help="article | default; Mario also levels (default: default)")
+    train.add_argument("--episodes", type=COUNT, default=None, help="episode budget (max_episodes)")
+    train.add_argument("--steps", type=COUNT, default=None, help="env step budget (max_env_steps)")
+    train.add_argument("--seed", type=SEED, default=0,
+                       help="seeds numpy, TensorFlow and the env (default 0); training env seeds stay "
+                            "below 1,000,000, apart from the evaluation seeds")
+    train.add_argument("--wandb", default="auto", choices=["auto", "online", "offline", "off"],
+                       help="auto = online when logged in, else offline (default auto)")
+    train.add_argument("--resume", nargs="?", const="latest", default=None, metavar="RUN_DIR",
+                       help="continue a run from its checkpoint (default: the latest run of this algo)")
+    train.add_argument("--run-dir", default=None, help="where the run writes (default runs/<name>)")
+    train.add_argument("--final-eval-episodes", type=NON_NEGATIVE, default=None,
+                       help="evaluation episodes after training, on unseen seeds "
+                            "(default 100; Mario 10; 0 = none)")
+    train.add_argument("--video", action="store_true", help="also render an MP4 of the trained agent")
+    train.add_argument("--publish", action="store_true",
+                       help="copy the trained model into saved_networks/EXPERIMENT/ALGO/")
+    train.add_argument("--no-progress", action="store_true", help="no progress bar")
+    _add_hyperparameters(train, argv)
+
+    for name, text in (("evaluate", "greedy mean +- std of a saved model on unseen seeds "
+                                    "(Mario: share of episodes reaching the flag, x position)"),
+                       ("render", "MP4 of a saved model playing (greedily; Mario samples from pi)")):
+        p = sub.add_parser(name, help=text, description=text)
+        p.add_argument("experiment")
+        p.add_argument("algo")
+        p.add_argument("--model", default=None,
+                       help="model folder, a finished run's folder, or a run in progress (its last "
+                            "checkpoint) (default saved_networks/EXPERIMENT/ALGO)")
+        p.add_argument("--world", type=whole_number(WORLD), default=None,
+                       help="Mario: the shipped model of this world (default 1)")
+        p.add_argument("--stage", type=whole_number(STAGE), default=None,
+                       help="Mario: the shipped model of this stage (default 1)")
+        if name == "evaluate":
+            p.add_argument("--episodes", type=COUNT, default=None, help="default 100; Mario 10")
+            p.add_argument("--seed-base", type=NON_NEGATIVE, default=None,
+                           help="episode i uses seed SEED_BASE+i (default: the experiment's unseen range)")
+            p.add_argument("--record", action="store_true",
+                           help="write the result into the model folder's meta.json as its evaluation")
+        else:
+            p.add_argument("--out", default=None,
+                           help="MP4 path, or a folder for it (default videos/EXPERIMENT_ALGO.mp4)")
+            p.add_argument("--fps", type=whole_number(Allowed(low=1, high=240)), default=None,
+                           help="frames per second (default: experiment's)")
+            p.add_argument("--episodes", type=COUNT, default=None, help="default 1; Minitaur 3")
+            p.add_argument("--seed", type=NON_NEGATIVE, default=None,
+                           help="episode i uses seed SEED+i (default: the first evaluation seed)")
+    sweep = sub.add_parser(
+        "sweep", help="many runs (seeds x grid values) on Ray Tune, locally or on a cluster",
+        description="One trial per combination of --seeds and --grid values; each trial is an ordinary "
+                    "run folder under sweeps/NAME/ (evaluate, render and plot work on it). A trial "
+                    "restarted after a crash resumes from its checkpoint; Ctrl-C or SIGTERM stops every trial "
+                    "at a checkpoint; --resume continues and skips finished trials.")
+    sweep.add_argument("experiment")
+    sweep.add_argument("algo")
+    sweep.add_argument("--seeds", default="0-4", help="a range or a list: 0-4, 0,3,7 (default 0-4)")
+    sweep.add_argument("--grid", action="append", default=[], metavar="NAME=V1,V2",
+                       help="a hyperparameter and its values (repeatable), e.g. --grid lr=1e-4,3e-4")
+    sweep.add_argument("--preset", default=None, help="article | default; Mario also levels (default: default)")
+    sweep.add_argument("--episodes", type=COUNT, default=None, help="episode budget of each run")
+    sweep.add_argument("--steps", type=COUNT, default=None, help="env step budget of each run")
+    sweep.add_argument("--final-eval-episodes", type=NON_NEGATIVE, default=None,
+                       help="evaluation episodes on unseen seeds after each run (default 100; Mario 10)")
+    sweep.add_argument("--max-concurrent", type=NON_NEGATIVE, default=0,
+                       help="trials at once (default 0: as many as the CPUs allow)")
+    sweep.add_argument("--cpus-per-run", type=whole_number(Allowed(low=1, high=256)), default=1,
+                       help="CPUs reserved per trial; TensorFlow's threads follow it (default 1)")
+    sweep.add_argument("--num-cpus", type=COUNT, default=None,
+                       help="CPUs of the local Ray instance (default: all of this machine's)")
+    sweep.add_argument("--name", type=folder_name, default=None,
+                       help="sweep folder name, under sweeps/ (default EXPERIMENT__ALGO)")
+    sweep.add_argument("--address", default=None,
+                       help="join a running Ray cluster (e.g. 10.0.0.5:6379) instead of starting local Ray")
+    sweep.add_argument("--resume", action="store_true", help="continue the sweep NAME; finished trials are kept")
+    report = sub.add_parser("report", help="results of sweeps: per run, and mean / median / IQM with 95%% CIs",
+                            description="Per run: the final evaluation on unseen seeds, env steps, wall time. "
+                                        "Over runs: mean, median and IQM with 95%% stratified bootstrap CIs "
+                                        "(rliable's method); with two sweeps, P(first beats second). Writes "
+                                        "report.md and report_curves.png into the first sweep folder.")
+    report.add_argument("sweep_dirs", nargs="+", metavar="SWEEP_DIR")
+    report.add_argument("--reps", type=whole_number(Allowed(low=100, high=10**6)), default=5000, help="bootstrap resamples")
+    report.add_argument("--keep", metavar="DIR", default=None,
+                        help="first copy sweep.json and, per run, model/meta.json, metrics.csv and evals.csv "
+                             "(not the checkpoints) into DIR, a folder git keeps such as "
+                             "results/sweeps/NAME, and write the report there")
+
+    plot = sub.add_parser("plot", help="write the training plots of a run folder (running, interrupted "
+                                       "or finished)",
+                          description="Write the training plots of a run folder from its CSV tables: score "
+                                      "per episode, periodic evaluations; for Mario, x position and flag "
+                                      "share, and a map of where episodes ended.")
+    plot.add_argument("run_dir", help="a run folder, e.g. runs/mario_ppo__ppo__0__<time>")
+    plot.add_argument("--out", default=None, help="folder for the PNGs (default RUN_DIR/plots)")
+    return parser
+
+
+class _Unparsable(Exception):
+    pass
+
+
+class _QuietParser(argparse.ArgumentParser):
+    def error(self, message):
+        raise _Unparsable(message)
+
+
+def _add_hyperparameters(train: argparse.ArgumentParser, argv: list[str]) -> None:
+    """Once EXPERIMENT and ALGO are on the command line, add one flag per hyperparameter.
+
+    A first, forgiving parse finds them (and ``--preset``) wherever they stand; a line it cannot
+    read is left to the full parse, which reports it. Hyperparameter flags are not known yet, so
+    it steps over any other ``--name value`` pair (every hyperparameter takes one value): a
+    ``--lr 1e-3`` before the names does not make ``1e-3`` the experiment.
+    """
+    if argv[:1] != ["train"]:
+        return
+    known = {option for action in train._actions for option in action.option_strings}
+    line, tokens = [], iter(argv[1:])
+    for token in tokens:
+        if token.startswith("--") and "=" not in token and token not in known:
+            next(tokens, None)
+        elif token not in ("-h", "--help"):
+            line.append(token)
+    first = _QuietParser(add_help=False)
+    first.add_argument("experiment")
+    first.add_argument("algo")
+    first.add_argument("--preset")
+    for action in train._actions:  # the other train options, so their values are not taken as names
+        if action.option_strings and action.dest not in ("help", "preset"):
+            if action.nargs == 0:
+                first.add_argument(*action.option_strings, action="store_true")
+            else:
+                first.add_argument(*action.option_strings, nargs=action.nargs, const=action.const)
+    try:
+        names, _ = first.parse_known_args(line)
+    except _Unparsable:
+        return
+    from rlcore.experiment import get_experiment
+    from rlcore.hparams import add_arguments
+
+    add_arguments(train, get_experiment(names.experiment).preset(names.algo, names.preset))
