@@ -167,13 +167,12 @@ def test_hyperparameters_before_the_names_are_read_as_hyperparameters(capsys):
     assert code == 2 and "--tau" in err and "7" in err and "unknown experiment" not in err
 
 
-@pytest.mark.parametrize("seed", [0, 7, 999, 1000, 123_456, MAX_RUN_SEED])
-def test_training_seeds_never_reach_the_evaluation_or_selection_seeds(seed):
+def test_every_experiment_evaluates_above_the_training_seeds():
+    """Training env seeds stay below TRAINING_SEED_SPAN (the seeds trainers really hand their envs:
+    tests/rlcore/test_training.py); every evaluation and selection seed is above it."""
     lowest = min(min(get_experiment(n).eval_seed_base, get_experiment(n).selection_seed_base)
                  for n in experiment_names())
     assert lowest >= TRAINING_SEED_SPAN
-    for index in (0, 1, 999, 10_000, 5_000_000):
-        assert 0 <= training_env_seed(seed, index) < TRAINING_SEED_SPAN
 
 
 def test_seed_zero_keeps_the_env_seeds_of_the_shipped_runs():

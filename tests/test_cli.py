@@ -3,6 +3,7 @@ import json
 import os
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -102,6 +103,28 @@ def test_render_failure_leaves_no_video(capsys, dqn_model_dir, tmp_path):
     assert code == 2 and not out.exists()
 
 
+def test_ctrl_c_mid_render_keeps_the_earlier_video_whole(capsys, dqn_model_dir, tmp_path, monkeypatch):
+    """Frames are being written when Ctrl-C comes: the video from before stays, no temporary file is left."""
+    from gymnasium.envs.box2d.lunar_lander import LunarLander
+
+    out = tmp_path / "videos" / "v.mp4"
+    out.parent.mkdir()
+    out.write_bytes(b"an earlier, good video")
+    step, steps = LunarLander.step, []
+
+    def interrupted_step(self, action):
+        steps.append(action)
+        if len(steps) == 20:
+            raise KeyboardInterrupt
+        return step(self, action)
+
+    monkeypatch.setattr(LunarLander, "step", interrupted_step)
+    code, _, err = run(capsys, "render", "lunar_lander", "dqn", "--model", str(dqn_model_dir), "--out", str(out))
+    assert code == 130 and len(steps) == 20, err
+    assert out.read_bytes() == b"an earlier, good video"
+    assert [p.name for p in out.parent.iterdir()] == ["v.mp4"]
+
+
 def test_resume_with_a_checkpoint_of_another_algorithm(capsys, tmp_path, monkeypatch):
     from rlcore.trainers import dqn as dqn_trainer
 
@@ -127,9 +150,11 @@ def test_wandb_online_without_network_fails_fast(capsys, tmp_path, monkeypatch):
     monkeypatch.setenv("WANDB_API_KEY", "a" * 40)
     monkeypatch.setenv("WANDB_INIT_TIMEOUT", "5")
     monkeypatch.setenv("WANDB_BASE_URL", "http://127.0.0.1:9")  # nothing listens: as with no network
+    started = time.monotonic()
     code, _, err = run(capsys, "train", "toy", "dqn", "--wandb", "online", "--no-progress",
                        "--run-dir", str(tmp_path / "run"), "--episodes", "2")
     assert code == 2 and "wandb could not start in online mode" in err
+    assert time.monotonic() - started < 25  # within the 5 s asked for (plus start-up), not wandb's own 90 s
 
 
 def test_list_and_help(capsys):

@@ -31,6 +31,7 @@ def test_two_outputs_and_tanh_come_back_as_a_list():
     x = layers.Dense(8, activation="tanh")(obs)
     model = keras.Model(obs, [layers.Dense(2)(x), layers.Dense(1)(x)])
     got = NumpyForward(model)(_obs())
+    assert isinstance(got, list) and len(got) == 2
     for g, want in zip(got, model(_obs())):
         np.testing.assert_allclose(g, want.numpy(), rtol=1e-4, atol=1e-6)
 

@@ -21,8 +21,11 @@ def test_ring_buffer_overwrites_oldest_and_round_trips():
 def test_sample_returns_consistent_transitions():
     memory = ReplayMemory(100, (1,))
     for i in range(50):
-        memory.add([i], i % 4, float(i), [i + 1], False)
+        memory.add([i], i % 4, float(i), [i + 1], i % 3 == 0)
     obs, action, reward, next_obs, terminated = memory.sample(32, np.random.default_rng(1))
     np.testing.assert_array_equal(next_obs[:, 0], obs[:, 0] + 1)
     np.testing.assert_array_equal(reward, obs[:, 0])
+    np.testing.assert_array_equal(action, obs[:, 0] % 4)  # every field from the same row
+    np.testing.assert_array_equal(terminated, obs[:, 0] % 3 == 0)
+    assert 0 < terminated.sum() < 32
     assert obs.dtype == np.float32 and action.dtype == np.int32

@@ -41,6 +41,14 @@ def test_interrupt_then_resume_continues_the_counters(algo, tmp_path, monkeypatc
     episodes = [int(line.split(",")[0]) for line in (model_dir / "metrics.csv").read_text().splitlines()[1:]]
     assert episodes == list(range(1, len(episodes) + 1)), "episode counter restarted or skipped"
     _assert_no_jump_at_the_resume(pd.read_csv(model_dir / "metrics.csv"), len(state["returns"]), algo)
+    steps = pd.read_csv(model_dir / "metrics.csv")["env_steps"].to_numpy()
+    assert (np.diff(steps) >= 0).all() and steps[len(state["returns"])] > state["env_steps"]  # not from 0
+    if algo == "ppo":  # the rollout counter goes on too: each rollout logged once, env steps at its pace
+        rollouts = pd.read_csv(spec.run_dir / "rollouts.csv")
+        assert rollouts["rollout"].tolist() == list(range(1, len(rollouts) + 1))
+        assert rollouts["rollout"].iloc[-1] > state["rollouts"] > 0
+        per_rollout = spec.config.n_steps * spec.config.num_envs
+        assert (rollouts["env_steps"] == rollouts["rollout"] * per_rollout).all()
 
 
 

@@ -1,5 +1,9 @@
 """StopRules (budgets and goals, and which one ended a run) and StopRequest (the stop file)."""
 import dataclasses
+import os
+import signal
+
+import pytest
 
 from rlcore.configs import EpisodeLoop, PPOConfig
 from rlcore.trainers.episodes import EpisodeBook
@@ -47,8 +51,15 @@ def test_stop_file_is_seen_and_stays_seen(tmp_path, monkeypatch):
     assert stop.poll()  # once asked, the run stops at its next safe point
 
 
-def test_without_a_stop_file_only_ctrl_c_stops():
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
+def test_without_a_stop_file_a_signal_stops_and_a_second_one_aborts(signum, capsys):
     stop = StopRequest(None)
     assert not stop.poll()
-    stop.requested = True
-    assert stop.poll()
+    before = signal.getsignal(signum)
+    with stop.catching_stop_signals():
+        os.kill(os.getpid(), signum)
+        assert stop.poll()  # the first: stop at the next safe point, with a checkpoint
+        with pytest.raises(KeyboardInterrupt):  # the second: abort without saving
+            os.kill(os.getpid(), signum)
+    assert signal.getsignal(signum) is before  # the handler before the run is back
+    assert "stopping at the next safe point" in capsys.readouterr().out

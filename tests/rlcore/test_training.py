@@ -133,6 +133,9 @@ def test_evaluation_uses_the_requested_seeds():
     assert len(a) == 7
     assert sorted(a) == sorted(b)
     assert sorted(a) != sorted(c)
+    # episode i is played on seed SEED_BASE + i, in that order
+    one_each = [evaluate(exp, always_one, episodes=1, seed_base=s, progress=False)[0] for s in range(5, 12)]
+    assert list(a) == one_each and len(set(one_each)) > 2
 
 
 @pytest.mark.parametrize("algo", ["dqn", "a2c"])
@@ -271,3 +274,31 @@ def test_sac_logs_the_experiments_info_keys(tmp_path):
     sac_trainer.train(spec)
     rows = pd.read_csv(spec.run_dir / "metrics.csv")
     assert len(rows) == 30 and rows["absent"].isna().all()  # declared, not reported by the env: empty
+
+
+@pytest.mark.parametrize("algo", ["dqn", "a2c"])
+def test_training_envs_are_seeded_below_the_evaluation_seeds(algo, tmp_path, monkeypatch):
+    """The seeds the trainers hand their envs, also after a resume and at the largest run seed, stay
+    below every experiment's evaluation and selection seeds."""
+    from rlcore.experiment import experiment_names, get_experiment
+    from rlcore.seeding import MAX_RUN_SEED, TRAINING_SEED_SPAN, training_env_seed
+
+    seeds, reset = [], toy.SignEnv.reset
+
+    def spy(self, *, seed=None, options=None):
+        if seed is not None:
+            seeds.append(seed)
+        return reset(self, seed=seed, options=options)
+
+    monkeypatch.setattr(toy.SignEnv, "reset", spy)
+    spec = toy.spec(algo, tmp_path, max_episodes=6, stop_score=99.0)
+    spec.seed = MAX_RUN_SEED
+    TRAINERS[algo].train(spec)
+    first = len(seeds)
+    spec.resume, spec.config = True, dataclasses.replace(spec.config, max_episodes=12)
+    TRAINERS[algo].train(spec)
+    assert first > 0 and len(seeds) > first  # the resume reseeded its envs
+    assert seeds[0] == training_env_seed(MAX_RUN_SEED, 0) and seeds[first] >= training_env_seed(MAX_RUN_SEED, 6)
+    lowest = min(min(get_experiment(n).eval_seed_base, get_experiment(n).selection_seed_base)
+                 for n in experiment_names() if not n.startswith("toy"))  # the package's, not this test's
+    assert max(seeds) < TRAINING_SEED_SPAN <= lowest, (max(seeds), lowest)
