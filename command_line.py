@@ -28,6 +28,8 @@ def folder_name(text: str) -> str:
     return text
 
 
+PRESET_HELP = ("a named set of hyperparameters: article, default, or another that `main.py list` shows "
+               "(default: default)")
 COUNT, NON_NEGATIVE = whole_number(allowed.COUNT), whole_number(allowed.NON_NEGATIVE)
 SEED = whole_number(Allowed(low=0, high=MAX_RUN_SEED))
 
@@ -45,7 +47,7 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
                                        "overridden; `main.py train EXPERIMENT ALGO --help` lists them.")
     train.add_argument("experiment", help="e.g. lunar_lander")
     train.add_argument("algo", help="e.g. dqn, ddqn, dueling_dqn, dueling_ddqn, a2c")
-    train.add_argument("--preset", default=None, help="article | default; Mario also levels (default: default)")
+    train.add_argument("--preset", default=None, help=PRESET_HELP)
     train.add_argument("--episodes", type=COUNT, default=None, help="episode budget (max_episodes)")
     train.add_argument("--steps", type=COUNT, default=None, help="env step budget (max_env_steps)")
     train.add_argument("--seed", type=SEED, default=0,
@@ -103,7 +105,7 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
     sweep.add_argument("--seeds", default="0-4", help="a range or a list: 0-4, 0,3,7 (default 0-4)")
     sweep.add_argument("--grid", action="append", default=[], metavar="NAME=V1,V2",
                        help="a hyperparameter and its values (repeatable), e.g. --grid lr=1e-4,3e-4")
-    sweep.add_argument("--preset", default=None, help="article | default; Mario also levels (default: default)")
+    sweep.add_argument("--preset", default=None, help=PRESET_HELP)
     sweep.add_argument("--episodes", type=COUNT, default=None, help="episode budget of each run")
     sweep.add_argument("--steps", type=COUNT, default=None, help="env step budget of each run")
     sweep.add_argument("--final-eval-episodes", type=NON_NEGATIVE, default=None,

@@ -215,11 +215,13 @@ def make_env(render_mode: str | None = None, max_episode_steps: int | None = Non
     from nes_py.wrappers import JoypadSpace
 
     from mario_ppo.episode_ends import DeadEnds, StallLimit
+    from mario_ppo.levels import STAGE, WORLD
     from mario_ppo.restarts import Restarts
     from rlcore.errors import UserError
 
-    if not (1 <= world <= 8 and 1 <= stage <= 4):
-        raise UserError(f"there is no level {world}-{stage}: world is 1-8, stage 1-4")
+    if not (WORLD.accepts(world) and STAGE.accepts(stage)):
+        raise UserError(f"there is no level {world}-{stage}: world is {WORLD.describe()}, "
+                        f"stage {STAGE.describe()}")
     if frames not in FRAME_STACKS:
         raise UserError(f"unknown frame stack {frames!r}; choose one of {', '.join(FRAME_STACKS)}")
     env = gym.make(f"SuperMarioBros-{world}-{stage}-v0", render_mode=render_mode).unwrapped

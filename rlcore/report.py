@@ -81,8 +81,8 @@ def load_runs(sweep_dir: Path) -> list[dict]:
             continue  # trained but not evaluated: nothing to aggregate
         rows.append({"trial": meta_path.parent.parent.name, "seed": meta["seed"], "score": float(score),
                      "eval_episodes": ev.get("episodes"), "env_steps": meta["env_steps"],
-                     "wall_seconds": meta["wall_seconds"], "run_dir": meta_path.parent.parent})
-        rows[-1]["what"] = f"{meta.get('experiment')} {meta.get('algo')}"
+                     "wall_seconds": meta["wall_seconds"], "run_dir": meta_path.parent.parent,
+                     "what": f"{meta.get('experiment')} {meta.get('algo')}"})
     if not rows:
         raise UserError(f"{sweep_dir} holds no finished, evaluated run (model/meta.json with an evaluation)")
     kinds = sorted({row["what"] for row in rows})

@@ -7,7 +7,7 @@ from rlcore.report import load_runs, summarize
 from tests.test_cli import ROOT
 
 KEPT = ROOT / "results" / "sweeps"
-SWEPT = sorted(p.name for p in KEPT.glob("*/sweep.json") for p in [p.parent])
+SWEPT = sorted(p.parent.name for p in KEPT.glob("*/sweep.json"))
 
 
 def test_the_kept_sweeps_are_in_the_clone():
