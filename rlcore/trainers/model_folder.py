@@ -24,6 +24,28 @@ def package_versions() -> dict:
     return found
 
 
+SIMD_FLAGS = ("avx2", "fma", "avx512f", "avx512_bf16", "amx_tile")  # what oneDNN picks its code paths by
+
+
+def cpu_description(cpuinfo: Path = Path("/proc/cpuinfo")) -> str:
+    """The CPU a run trained on, e.g. ``AMD EPYC (avx2 fma avx512f)``. A seed repeats a run bit for bit
+    on one machine, but TensorFlow's oneDNN kernels order float sums by the CPU's vector units, so the
+    same seed on another CPU can drift (seen on LunarLander's dueling runs); meta.json says which."""
+    try:
+        text = cpuinfo.read_text()
+    except OSError:
+        return platform.processor() or platform.machine() or "unknown"
+    first = {}  # the first core's fields
+    for line in text.splitlines():
+        if ":" in line:
+            key, value = (part.strip() for part in line.split(":", 1))
+            first.setdefault(key, value)
+    name = first.get("model name") or platform.processor() or platform.machine() or "unknown"
+    flags = set(first.get("flags", "").split())
+    simd = [f for f in SIMD_FLAGS if f in flags]
+    return f"{name} ({' '.join(simd)})" if simd else name
+
+
 def write_model_folder(run_dir: Path, experiment, describe: dict, save_models, record: dict) -> Path:
     """``save_models(folder)`` writes the model files; ``record`` (commands, counters, ...) goes into
     meta.json after ``describe`` (what the run is). Returns the folder."""
@@ -35,6 +57,7 @@ def write_model_folder(run_dir: Path, experiment, describe: dict, save_models, r
         (model_dir / table.name).write_bytes(table.read_bytes())
     meta = {**describe, "command": record["commands"][0], **record, "model_files": files,
             "plot": plot_name, "versions": package_versions(),
+            "cpu": cpu_description(),
             "finished": datetime.now(timezone.utc).isoformat(timespec="seconds")}
     write_json(model_dir / "meta.json", meta)
     return model_dir

@@ -15,6 +15,7 @@ from rlcore.trainers import a2c as a2c_trainer
 from rlcore.trainers import dqn as dqn_trainer
 from rlcore.trainers import ppo as ppo_trainer
 from rlcore.trainers import sac as sac_trainer
+from rlcore.trainers.model_folder import cpu_description
 from tests import toy
 from tests.toy import TRAINERS
 
@@ -28,6 +29,7 @@ def test_learns_the_toy_task(algo, tmp_path):
     returns = evaluate(exp, policy, episodes=20, progress=False)
     assert returns.mean() >= 9.0, f"{algo} greedy return {returns.mean()} after {meta['episodes']} episodes"
     assert meta["command"] == "pytest" and meta["env_steps"] > 0 and meta["seed"] == 0
+    assert meta["cpu"] == cpu_description() and meta["cpu"] != "unknown"  # where the seed's numbers came from
     assert (model_dir / meta["plot"]).stat().st_size > 1000
     csv_lines = (model_dir / "metrics.csv").read_text().splitlines()
     assert csv_lines[0].startswith("episode,total_points,av_latest_points,target_ave_scores")
