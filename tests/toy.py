@@ -142,7 +142,7 @@ class ReachEnv(gym.Env):
         reward = -float(np.abs(np.asarray(action) - self.target).sum()) / 2
         self.t += 1
         self.target = self.np_random.uniform(-0.8, 0.8, 2).astype(np.float32)
-        return self.target.copy(), reward, False, self.t >= self.length, {}
+        return self.target.copy(), reward, False, self.t >= self.length, {"t": self.t}
 
     def render(self):
         return np.zeros((32, 32, 3), np.uint8)

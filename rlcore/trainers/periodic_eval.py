@@ -4,7 +4,8 @@ Only the episode-driven configs (``EpisodeLoop``: DQN, A2C, SAC) ask for it; for
 (PPO) it is switched off. Every ``eval_every_steps`` env steps the greedy policy plays
 ``eval_episodes`` episodes on the fixed selection seeds (never the final evaluation's); the mean,
 the std and the share of episodes that lasted to the time limit go to ``evals.csv``; the best
-mean is remembered, with a snapshot of its weights when ``keep_best`` is set, and
+mean is remembered (a tie goes to the later evaluation: the same score with more training behind
+it), with a snapshot of its weights when ``keep_best`` is set, and
 ``stop_eval_score`` can end the run once an evaluation reaches it.
 """
 from __future__ import annotations

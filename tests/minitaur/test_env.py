@@ -62,6 +62,21 @@ def test_reward_is_forward_progress_minus_energy():
     env.close()
 
 
+def test_the_first_steps_progress_counts_from_the_origin_as_pybullets():
+    """pybullet's -v0 task starts its last position at (0, 0, 0), not at the robot's start, so the
+    first step's progress is the base's x after that step (our reset keeps that; later steps count
+    from the step before)."""
+    env = MinitaurEnv(randomize=False)
+    env.reset(seed=0)
+    start_x = env.robot.base_pose()[0][0]
+    _, _, _, _, first = env.step(np.zeros(8))
+    _, _, _, _, second = env.step(np.zeros(8))
+    assert first["forward"] == pytest.approx(first["x"], abs=1e-12)
+    assert abs(start_x) > 1e-6 and first["forward"] != pytest.approx(first["x"] - start_x, abs=1e-9)
+    assert second["forward"] == pytest.approx(second["x"] - first["x"], abs=1e-12)
+    env.close()
+
+
 def test_a_forward_push_pays_and_a_backward_push_costs():
     """Push the base along +x with no motor effort: reward > 0; along -x: reward < 0."""
     rewards = {}

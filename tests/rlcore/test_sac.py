@@ -129,6 +129,26 @@ def test_greedy_is_tanh_of_the_mean_and_sampling_stays_in_bounds():
     assert sampled.shape == (1000, ACT) and np.all(np.abs(sampled) <= 1.0)
 
 
+def test_sampled_actions_are_tanh_of_the_gaussian_the_actor_gives():
+    """Known mean and std (a zero kernel leaves the output layer's bias): the pre-tanh samples have
+    that mean and std, per action dimension, and a seed gives exactly tanh(mean + std * normal)."""
+    agent = SACAgent(OBS, ACT, CFG)
+    weights = agent.actor.get_weights()
+    weights[-2] = np.zeros_like(weights[-2])
+    mean, log_std = np.array([0.5, -0.2, 0.0], np.float32), np.array([-1.0, 0.0, -2.0], np.float32)
+    weights[-1] = np.concatenate([mean, log_std])
+    agent.actor.set_weights(weights)
+    agent.sync_policy_weights()
+    obs = np.random.default_rng(0).normal(size=(20_000, OBS)).astype(np.float32)
+    sampled = agent.act(obs, np.random.default_rng(5))
+    pre_tanh = np.arctanh(np.clip(sampled.astype(np.float64), -1 + 1e-7, 1 - 1e-7))
+    std = np.exp(log_std)
+    np.testing.assert_allclose(pre_tanh.mean(axis=0), mean, atol=4 * std.max() / np.sqrt(len(obs)))
+    np.testing.assert_allclose(pre_tanh.std(axis=0), std, rtol=0.03)
+    want = np.tanh(mean + std * np.random.default_rng(5).standard_normal((len(obs), ACT)))
+    np.testing.assert_allclose(sampled, want, rtol=1e-5, atol=1e-6)
+
+
 def test_checkpoint_round_trip_restores_all_five_networks_and_three_adams(tmp_path):
     tf.keras.utils.set_random_seed(0)
     agent = SACAgent(OBS, ACT, CFG)
