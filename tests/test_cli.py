@@ -136,8 +136,6 @@ def test_resume_with_a_checkpoint_of_another_algorithm(capsys, tmp_path, monkeyp
 
 
 def test_nan_during_training_stops_with_a_clear_error(capsys, tmp_path, monkeypatch):
-    import numpy as np
-
     monkeypatch.setitem(registry.EXPERIMENT_MODULES, "toy", "tests.toy")
     monkeypatch.setattr(toy.SignEnv, "step", lambda self, a: (self._obs(), np.nan, False, False, {}))
     code, _, err = run(capsys, "train", "toy", "dqn", "--wandb", "off", "--no-progress",
@@ -173,67 +171,6 @@ def test_every_help_page_prints(capsys, argv):
     assert code == 0 and out.startswith("usage: main.py")
     if not argv:  # the top page names every command
         assert all(name in out for name in main.COMMANDS)
-
-
-def test_plot_of_an_unfinished_mario_run(capsys, tmp_path):
-    """A run with only a checkpoint and its metrics (training still going) gets its plots."""
-    from rlcore.checkpoint import save_checkpoint
-
-    rows = ["episode,total_points,av_latest_points,target_ave_scores,x_pos,success,success_share"]
-    rows += [f"{i},{i % 7 * 10},{30 + i / 10},0,{300 + 40 * i},{int(i == 20)},{0.05 * (i >= 20)}"
-             for i in range(1, 31)]
-    (tmp_path / "metrics.csv").write_text("\n".join(rows) + "\n")
-    save_checkpoint(tmp_path / "checkpoint.npz", {}, {}, {"experiment": "mario_ppo", "algo": "ppo",
-                                                          "preset": "default", "seed": 0,
-                                                          "config": {"window": 20}})
-    code, out, err = run(capsys, "plot", str(tmp_path))
-    assert code == 0, err
-    written = [line.split()[-1] for line in out.splitlines()]
-    assert [Path(p).name for p in written] == ["mario_ppo_Train_ppo.png", "mario_ppo_Progress_ppo.png",
-                                              "mario_ppo_Endings_ppo.png"]
-    assert all(Path(p).stat().st_size > 1000 for p in written)
-
-
-def test_mario_plots_leave_out_restarted_episodes(capsys, tmp_path, monkeypatch):
-    """Restarts start at x 2,900: their ends must not show in the endings map or the curves."""
-    import rlcore.plotting as plotting
-    from rlcore.checkpoint import save_checkpoint
-
-    rows = ["episode,total_points,av_latest_points,target_ave_scores,x_pos,success,success_share,restarted"]
-    rows += [f"{i},{5 if i % 2 else 300},0,0,{3000 if i % 2 else 300 + i},0,0,{i % 2}" for i in range(1, 41)]
-    (tmp_path / "metrics.csv").write_text("\n".join(rows) + "\n")
-    save_checkpoint(tmp_path / "checkpoint.npz", {}, {}, {"experiment": "mario_ppo", "algo": "ppo",
-                                                          "preset": "default", "seed": 0,
-                                                          "config": {"window": 20}})
-    ended_at, kept = [], []  # what the endings map and each plot were given
-    ending_shares, full_episodes = plotting.ending_shares, plotting.full_episodes
-
-    def spy_ending_shares(x, *args, **kwargs):
-        ended_at.extend(x)
-        return ending_shares(x, *args, **kwargs)
-
-    def spy_full_episodes(df, key):
-        kept.append(full_episodes(df, key))
-        return kept[-1]
-
-    monkeypatch.setattr(plotting, "ending_shares", spy_ending_shares)
-    monkeypatch.setattr(plotting, "full_episodes", spy_full_episodes)
-    code, _, err = run(capsys, "plot", str(tmp_path))
-    assert code == 0, err
-    assert sorted(ended_at) == [300 + i for i in range(2, 41, 2)]  # the 20 episodes from the start
-    assert len(kept) == 3 and all(len(df) == 20 and (df["restarted"] == 0).all() for df in kept)
-
-
-def test_ending_shares_say_where_each_block_of_episodes_ended():
-    from rlcore.plotting import ending_shares
-
-    # 10 episodes end at x 100, then 10 at x 900 (the farthest any got), then 5 split 450 / 900
-    x = [100.0] * 10 + [900.0] * 10 + [450.0, 900.0, 450.0, 900.0, 450.0]
-    starts, edges, shares = ending_shares(x, block=10, bins=9)
-    assert starts.tolist() == [1, 11, 21] and edges[0] == 0 and edges[-1] == 900
-    np.testing.assert_allclose(shares.sum(axis=0), 1.0)
-    assert shares[1, 0] == 1.0 and shares[8, 1] == 1.0  # x 100 in bin [100, 200), x 900 in the last bin
-    assert shares[4, 2] == pytest.approx(0.6) and shares[8, 2] == pytest.approx(0.4)
 
 
 @pytest.mark.parametrize("signal_name", ["SIGINT", "SIGTERM"])
@@ -325,13 +262,3 @@ def test_evaluate_and_render_a_run_in_progress_and_a_finished_run_folder(capsys,
     dqn_trainer.train(spec)  # finishes: model/ appears
     code, out, err = run(capsys, "evaluate", "toy", "dqn", "--model", str(spec.run_dir), "--episodes", "3")
     assert code == 0 and f"({spec.run_dir / 'model'}): " in out, err
-
-
-def test_a_plot_title_names_the_mario_level():
-    from rlcore.experiment import get_experiment
-    from rlcore.plotting import plot_title
-
-    about = {"algo": "ppo", "preset": "default", "seed": 0, "config": {"world": 2, "stage": 1}}
-    assert plot_title(get_experiment("mario_ppo"), about) == "mario_ppo ppo 2-1 (default preset, seed 0)"
-    about = {"algo": "dqn", "preset": "article", "seed": 3, "config": {}}
-    assert plot_title(get_experiment("lunar_lander"), about) == "lunar_lander dqn (article preset, seed 3)"
