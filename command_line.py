@@ -32,6 +32,9 @@ PRESET_HELP = ("a named set of hyperparameters: article, default, or another tha
                "(default: default)")
 COUNT, NON_NEGATIVE = whole_number(allowed.COUNT), whole_number(allowed.NON_NEGATIVE)
 SEED = whole_number(Allowed(low=0, high=MAX_RUN_SEED))
+# an evaluation plays one unseen seed per episode, from 1,000,000 up to the selection seeds (2,000,000)
+EVAL_EPISODES = whole_number(Allowed(low=1, high=1_000_000))
+FINAL_EVAL_EPISODES = whole_number(Allowed(low=0, high=1_000_000))
 
 
 def build_parser(argv: list[str]) -> argparse.ArgumentParser:
@@ -58,7 +61,7 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
     train.add_argument("--resume", nargs="?", const="latest", default=None, metavar="RUN_DIR",
                        help="continue a run from its checkpoint (default: the latest run of this algo)")
     train.add_argument("--run-dir", default=None, help="where the run writes (default runs/<name>)")
-    train.add_argument("--final-eval-episodes", type=NON_NEGATIVE, default=None,
+    train.add_argument("--final-eval-episodes", type=FINAL_EVAL_EPISODES, default=None,
                        help="evaluation episodes after training, on unseen seeds "
                             "(default 100; Mario 10; 0 = none)")
     train.add_argument("--video", action="store_true", help="also render an MP4 of the trained agent")
@@ -81,7 +84,7 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
         p.add_argument("--stage", type=whole_number(STAGE), default=None,
                        help="Mario: the shipped model of this stage (default 1)")
         if name == "evaluate":
-            p.add_argument("--episodes", type=COUNT, default=None, help="default 100; Mario 10")
+            p.add_argument("--episodes", type=EVAL_EPISODES, default=None, help="default 100; Mario 10")
             p.add_argument("--seed-base", type=NON_NEGATIVE, default=None,
                            help="episode i uses seed SEED_BASE+i (default: the experiment's unseen range)")
             p.add_argument("--record", action="store_true",
@@ -91,7 +94,7 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
                            help="MP4 path, or a folder for it (default videos/EXPERIMENT_ALGO.mp4)")
             p.add_argument("--fps", type=whole_number(Allowed(low=1, high=240)), default=None,
                            help="frames per second (default: experiment's)")
-            p.add_argument("--episodes", type=COUNT, default=None, help="default 1; Minitaur 3")
+            p.add_argument("--episodes", type=EVAL_EPISODES, default=None, help="default 1; Minitaur 3")
             p.add_argument("--seed", type=NON_NEGATIVE, default=None,
                            help="episode i uses seed SEED+i (default: the first evaluation seed)")
     sweep = sub.add_parser(
@@ -108,7 +111,7 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
     sweep.add_argument("--preset", default=None, help=PRESET_HELP)
     sweep.add_argument("--episodes", type=COUNT, default=None, help="episode budget of each run")
     sweep.add_argument("--steps", type=COUNT, default=None, help="env step budget of each run")
-    sweep.add_argument("--final-eval-episodes", type=NON_NEGATIVE, default=None,
+    sweep.add_argument("--final-eval-episodes", type=FINAL_EVAL_EPISODES, default=None,
                        help="evaluation episodes on unseen seeds after each run (default 100; Mario 10)")
     sweep.add_argument("--max-concurrent", type=NON_NEGATIVE, default=0,
                        help="trials at once (default 0: as many as the CPUs allow)")

@@ -59,6 +59,12 @@ BAD_VALUES = [
     (["evaluate", "lunar_lander", "dqn", "--seed-base", "-1"], "argument --seed-base: -1 is invalid"),
     (["render", "lunar_lander", "dqn", "--fps", "0"], "argument --fps: 0 is invalid"),
     (["render", "lunar_lander", "dqn", "--episodes", "0"], "argument --episodes: 0 is invalid"),
+    # one unseen seed per evaluation episode: no more episodes than that range holds
+    (["evaluate", "lunar_lander", "dqn", "--episodes", "1000001"], "argument --episodes: 1000001 is invalid: "
+                                                                   "allowed is a number from 1 to 1000000"),
+    (["render", "lunar_lander", "dqn", "--episodes", str(10**20)], "argument --episodes: "),
+    (["train", "lunar_lander", "dqn", "--final-eval-episodes", "2000000"], "argument --final-eval-episodes: "
+                                                                          "2000000 is invalid"),
     (["render", "lunar_lander", "dqn", "--seed", "x"], "argument --seed: 'x' is not a whole number"),
     (["train", "minitaur", "sac", "--obs-norm", "maybe"], "argument --obs-norm: 'maybe' is invalid: allowed is true or false"),
     # PPO offers no flag it would ignore
