@@ -11,7 +11,7 @@ import argparse
 from mario_ppo.levels import STAGE, WORLD
 from rlcore import allowed
 from rlcore.allowed import Allowed, whole_number
-from rlcore.seeding import MAX_RUN_SEED
+from rlcore.seeding import MAX_EVAL_EPISODES, MAX_RUN_SEED
 
 
 class _Parser(argparse.ArgumentParser):
@@ -32,9 +32,8 @@ PRESET_HELP = ("a named set of hyperparameters: article, default, or another tha
                "(default: default)")
 COUNT, NON_NEGATIVE = whole_number(allowed.COUNT), whole_number(allowed.NON_NEGATIVE)
 SEED = whole_number(Allowed(low=0, high=MAX_RUN_SEED))
-# an evaluation plays one unseen seed per episode, from 1,000,000 up to the selection seeds (2,000,000)
-EVAL_EPISODES = whole_number(Allowed(low=1, high=1_000_000))
-FINAL_EVAL_EPISODES = whole_number(Allowed(low=0, high=1_000_000))
+EVAL_EPISODES = whole_number(Allowed(low=1, high=MAX_EVAL_EPISODES))  # one unseen seed per episode
+FINAL_EVAL_EPISODES = whole_number(Allowed(low=0, high=MAX_EVAL_EPISODES))
 
 
 def build_parser(argv: list[str]) -> argparse.ArgumentParser:

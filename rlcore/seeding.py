@@ -8,6 +8,8 @@ from __future__ import annotations
 
 TRAINING_SEED_SPAN = 1_000_000
 MAX_RUN_SEED = 2**32 - 1  # numpy and TensorFlow take seeds below 2**32
+# a final evaluation plays one seed per episode, from eval_seed_base up to where the selection seeds begin
+MAX_EVAL_EPISODES = 1_000_000  # = Experiment.selection_seed_base - Experiment.eval_seed_base
 
 
 def training_env_seed(run_seed: int, index: int) -> int:

@@ -11,7 +11,7 @@ import pytest
 
 import main
 from rlcore.experiment import experiment_names, get_experiment
-from rlcore.seeding import MAX_RUN_SEED, TRAINING_SEED_SPAN, training_env_seed
+from rlcore.seeding import MAX_EVAL_EPISODES, MAX_RUN_SEED, TRAINING_SEED_SPAN, training_env_seed
 from tests.test_cli import ROOT, run
 
 BAD_VALUES = [
@@ -179,6 +179,10 @@ def test_every_experiment_evaluates_above_the_training_seeds():
     lowest = min(min(get_experiment(n).eval_seed_base, get_experiment(n).selection_seed_base)
                  for n in experiment_names())
     assert lowest >= TRAINING_SEED_SPAN
+    # the largest allowed evaluation (--episodes) stays below every experiment's selection seeds
+    for name in experiment_names():
+        experiment = get_experiment(name)
+        assert experiment.eval_seed_base + MAX_EVAL_EPISODES <= experiment.selection_seed_base
 
 
 def test_seed_zero_keeps_the_env_seeds_of_the_shipped_runs():
