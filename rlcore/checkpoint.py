@@ -63,9 +63,16 @@ def load_checkpoint(path: str | Path, models: dict, optimizers: dict) -> tuple[d
                       if f"optimizer/{name}/{i}" in files]
             _check_shapes(path, name, [tuple(v.shape) for v in opt.variables], [v.shape for v in values])
             for var, value in zip(opt.variables, values):
-                var.assign(value)
+                if not _is_learning_rate(var):  # the run's config says the rate (``--resume --lr``)
+                    var.assign(value)
         arrays = {key[len("array/"):]: data[key] for key in files if key.startswith("array/")}
     return state, arrays
+
+
+def _is_learning_rate(var) -> bool:
+    """Keras 3 keeps an optimizer's rate among its variables; a resume with a new ``--lr`` must keep
+    the rate the optimizer was built with, not the one saved in the checkpoint."""
+    return getattr(var, "path", "").rsplit("/", 1)[-1] == "learning_rate"
 
 
 def _check_shapes(path, name, expected, found):

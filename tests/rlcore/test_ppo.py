@@ -181,6 +181,17 @@ def test_checkpoint_round_trip_restores_weights_and_adam(tmp_path):
         np.testing.assert_allclose(a, b, rtol=1e-6)
 
 
+def test_a_resume_keeps_the_configured_learning_rate(tmp_path):
+    """``--resume --lr X``: Adam's moments and step come back, its rate is the new config's."""
+    agent = PPOAgent(OBS, 5, CFG)
+    agent.update(*_rollout(np.random.default_rng(0)), np.random.default_rng(0))
+    save_checkpoint(tmp_path / "c.npz", agent.models(), agent.optimizers(), {})
+    other = PPOAgent(OBS, 5, dataclasses.replace(CFG, lr=2.5e-4))
+    load_checkpoint(tmp_path / "c.npz", other.models(), other.optimizers())
+    assert float(other.opt.learning_rate) == pytest.approx(2.5e-4)
+    assert int(other.opt.iterations) == int(agent.opt.iterations) > 0
+
+
 def test_nan_in_the_loss_is_caught():
     agent = PPOAgent(OBS, 5, CFG)
     rollout = list(_rollout(np.random.default_rng(0)))
