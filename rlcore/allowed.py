@@ -24,13 +24,14 @@ class Allowed:
     """A range (``low``/``high``, each inclusive unless ``*_open``) or a set of ``choices``.
 
     Numbers must also be finite. For a tuple field the rule applies to every item, and the tuple
-    must not be empty.
+    must not be empty unless ``empty_ok`` (a list where empty means "off").
     """
     low: float | None = None
     high: float | None = None
     low_open: bool = False
     high_open: bool = False
     choices: tuple = ()
+    empty_ok: bool = False
 
     def describe(self) -> str:
         if self.choices:
@@ -94,8 +95,9 @@ def check_fields(cfg) -> None:
         if allowed is None:
             continue
         if isinstance(value, tuple):
-            if not value or not all(allowed.accepts(item) for item in value):
-                raise invalid(f.name, value, f"a comma-separated list, each item {allowed.describe()}")
+            if (not value and not allowed.empty_ok) or not all(allowed.accepts(item) for item in value):
+                empty = " (or empty)" if allowed.empty_ok else ""
+                raise invalid(f.name, value, f"a comma-separated list, each item {allowed.describe()}{empty}")
         elif not allowed.accepts(value):
             raise invalid(f.name, value, allowed.describe())
 

@@ -124,6 +124,10 @@ class PPOConfig(RunBudget):
     epochs: int = _h(10, "passes over each rollout", COUNT)
     minibatch: int = _h(256, "transitions per gradient step", COUNT)
     lr: float = _h(1e-4, "Adam learning rate", POSITIVE)
+    lr_halve_at: tuple[float, ...] = _h((), "halve the learning rate the first time the success share "
+                                            "(as the stop rule reads it) reaches each of these, e.g. 0.3,0.45 "
+                                            "(empty = never); --lr is the rate before any halving",
+                                        Allowed(low=0, high=1, low_open=True, empty_ok=True))
     gamma: float = _h(0.99, "discount factor", UNIT)
     gae_lambda: float = _h(0.97, "GAE lambda", UNIT)
     clip: float = _h(0.2, "PPO clip range of the probability ratio",

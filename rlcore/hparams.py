@@ -29,7 +29,10 @@ def _parser_for(annotation) -> typing.Callable[[str], object]:
         return annotation
     if typing.get_origin(annotation) is tuple:
         (item,) = {a for a in typing.get_args(annotation) if a is not Ellipsis}
-        return lambda text: tuple(item(part) for part in text.split(",") if part.strip())
+        def parse(text: str) -> tuple:
+            return tuple(item(part) for part in text.split(",") if part.strip())
+        parse.__name__ = f"comma-separated {item.__name__}"  # argparse's "invalid ... value: 'x'"
+        return parse
     raise TypeError(f"unsupported hyperparameter type {annotation!r}")
 
 
@@ -44,7 +47,7 @@ def add_arguments(parser: argparse.ArgumentParser, cfg) -> None:
     types = field_types(type(cfg))
     for f in dataclasses.fields(cfg):
         value = getattr(cfg, f.name)
-        shown = ",".join(map(str, value)) if isinstance(value, tuple) else value
+        shown = (",".join(map(str, value)) or "empty") if isinstance(value, tuple) else value
         group.add_argument(f"--{f.name.replace('_', '-')}", dest=f"hp_{f.name}", default=None,
                            type=types[f.name], metavar=type(value).__name__.upper(),
                            help=f"{f.metadata.get('help', '')} (default: {shown}{_allowed_text(f)})")

@@ -174,6 +174,10 @@ class PPOAgent:
         means = self._update(obs, actions, logp_old, values, next_values, rewards, terminated, dones, perms)
         return dict(zip(UPDATE_NAMES, (float(x) for x in means.numpy())))
 
+    def set_learning_rate(self, lr: float) -> None:
+        """Adam's rate for the next updates (a variable, so the compiled update is not retraced)."""
+        self.opt.learning_rate.assign(lr)
+
     # ------------------------------------------------------------ persistence
     def save(self, folder: str | Path) -> list[Path]:
         return [save_keras_model(self.model, Path(folder) / MODEL_FILE)]

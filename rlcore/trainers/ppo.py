@@ -17,6 +17,7 @@ from rlcore.agents.ppo import MODEL_FILE, UPDATE_NAMES, PPOAgent
 from rlcore.errors import UserError
 from rlcore.trainers import checkpoints
 from rlcore.trainers.divergence import reported_divergence
+from rlcore.trainers.lr_halving import LearningRateHalving
 from rlcore.trainers.session import TrainingSession
 from rlcore.trainers.spec import RunSpec
 from rlcore.trainers.rollout_log import RolloutLog
@@ -63,11 +64,14 @@ def train(spec: RunSpec) -> Path:
     session = TrainingSession(spec, state, progress_unit="step")
     book = session.book
     rollouts = int(state.get("rollouts", 0)) if state else 0
+    lr = LearningRateHalving(cfg.lr, cfg.lr_halve_at, cfg.window, state)
+    agent.set_learning_rate(lr.rate())  # a resume comes back at the rate its halvings left
 
     env_kept = {}  # what the envs built up (Mario: the restart routes), read while the pool is open
 
     def checkpoint():
-        checkpoints.save(session, agent, rng, env_arrays=env_kept, rollouts=rollouts, init_from=parent)
+        checkpoints.save(session, agent, rng, env_arrays=env_kept, rollouts=rollouts, init_from=parent,
+                         **lr.state())
 
     t, n = cfg.n_steps, cfg.num_envs
     buf = Rollout(t, n, obs_shape)
@@ -102,9 +106,13 @@ def train(spec: RunSpec) -> Path:
             with reported_divergence(session, "PPO", "lower --lr"):
                 losses = agent.update(*buf.arrays(), rng)
             rollouts += 1
-            session.log_rollout(rollouts, {**log.row(), **losses})
+            session.log_rollout(rollouts, {**log.row(), **losses, "lr": lr.rate()})
             line = log.line(rollouts, session.env_steps, book, cfg.window)
             tqdm.write(line + f" | loss {losses['loss']:.3f} entropy {losses['entropy']:.2f}")
+            halved = lr.observe(book.successes, book.success_share)
+            if halved:
+                agent.set_learning_rate(lr.rate())
+                tqdm.write(halved)
             if rollouts % cfg.checkpoint_rollouts == 0:
                 env_kept = checkpoints.env_memory(envs, exp.env_memory)
                 checkpoint()

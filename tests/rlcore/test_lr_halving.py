@@ -1,0 +1,68 @@
+"""``--lr-halve-at``: the rate halves once per mark the best full-window success share reaches; PPO's
+Adam follows it, rollouts.csv logs it, and a resume comes back at the halved rate."""
+import dataclasses
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from rlcore.configs import PPOConfig
+from rlcore.errors import UserError
+from rlcore.trainers import ppo as ppo_trainer
+from rlcore.trainers.lr_halving import LearningRateHalving
+from rlcore.trainers.spec import CHECKPOINT_FILE
+from tests import toy
+
+pytestmark = pytest.mark.usefixtures("toy_experiments")
+
+
+def test_each_mark_halves_once_and_only_with_a_full_window():
+    lr = LearningRateHalving(1e-4, (0.45, 0.3), window=4)
+    assert lr.observe([True] * 3, 1.0) is None and lr.rate() == 1e-4  # window not full yet
+    assert lr.observe([False, True, False, False], 0.25) is None and lr.rate() == 1e-4
+    assert "0.0001 -> 5e-05" in lr.observe([True] * 4, 0.35)  # only the list's length is read
+    assert lr.observe([False] * 4, 0.0) is None and lr.rate() == 5e-5  # a fall does not raise it back
+    assert lr.observe([True, False, False, False], 0.25) is None and lr.rate() == 5e-5  # nor a return
+    assert "5e-05 -> 2.5e-05" in lr.observe([True, True, False, True], 0.75)
+    assert lr.observe([True] * 4, 1.0) is None and lr.rate() == 2.5e-5  # no mark left
+    # a resume from the kept state comes back at the same rate; --lr is the rate before halving
+    again = LearningRateHalving(2e-4, (0.3, 0.45), 4, lr.state())
+    assert again.rate() == pytest.approx(5e-5)
+    assert LearningRateHalving(1e-4, (), 4).state() == {}
+
+
+@pytest.mark.parametrize("marks", [(0.0,), (1.5,), (0.3, float("nan"))])
+def test_marks_outside_0_to_1_are_refused(marks):
+    with pytest.raises(UserError, match="--lr-halve-at"):
+        PPOConfig(lr_halve_at=marks)
+
+
+def test_ppo_halves_adam_rate_as_the_share_rises_and_a_resume_keeps_it(tmp_path):
+    spec = toy.spec("ppo", tmp_path, lr_halve_at=(0.3, 0.6))
+    ppo_trainer.train(spec)
+    rollouts = pd.read_csv(spec.run_dir / "rollouts.csv")
+    metrics = pd.read_csv(spec.run_dir / "metrics.csv")
+    # the reference: the share at the end of each rollout, its running best, and the marks it passed
+    steps = spec.config.n_steps * spec.config.num_envs
+    best, expected = 0.0, []
+    for r in rollouts["rollout"]:
+        expected.append(1e-3 * 0.5 ** sum(best >= mark for mark in (0.3, 0.6)))
+        ended = metrics[metrics["env_steps"] <= r * steps]
+        if len(ended) >= spec.config.window:
+            best = max(best, ended["success_share"].iloc[-1])
+    np.testing.assert_allclose(rollouts["lr"], expected)
+    assert rollouts["lr"].iloc[0] == 1e-3 and rollouts["lr"].iloc[-1] == pytest.approx(2.5e-4)
+    # Adam itself ran at the last rate: its learning-rate variable is in the checkpoint
+    with np.load(spec.run_dir / CHECKPOINT_FILE) as data:
+        assert float(data["optimizer/adam/1"]) == pytest.approx(2.5e-4)
+
+    # a resume (after the rate was halved twice) goes on at 2.5e-4, not at --lr's 1e-3
+    before = len(rollouts)
+    spec.resume = True
+    spec.config = dataclasses.replace(spec.config, max_episodes=len(metrics) + 10, stop_success_share=0.0)
+    ppo_trainer.train(spec)
+    resumed = pd.read_csv(spec.run_dir / "rollouts.csv").iloc[before:]
+    assert len(resumed)
+    np.testing.assert_allclose(resumed["lr"], 2.5e-4)
+    with np.load(spec.run_dir / CHECKPOINT_FILE) as data:
+        assert float(data["optimizer/adam/1"]) == pytest.approx(2.5e-4)
