@@ -1,5 +1,5 @@
 """A model folder made from a run's last checkpoint, so ``evaluate`` and ``render`` work on a run that
-is still training or was stopped (``--model long_runs/mario_ppo/2-1``), as RL Zoo's
+is still training or was stopped (``--model long_runs/mario_ppo/2-2``), as RL Zoo's
 ``enjoy --load-checkpoint`` does. The folder holds the acting network(s) and a ``meta.json`` that
 names the checkpoint it came from; nothing is written into the run folder.
 """
