@@ -43,6 +43,12 @@ class EpisodeBook:
     def full_window(self) -> bool:
         return len(self.counted_returns) >= self.window
 
+    @property
+    def settled_success_share(self) -> float | None:
+        """The success share once ``window`` counted episodes have reported success, else None (what
+        the stop rule and ``--lr-halve-at`` read, so a lucky first few episodes do not count)."""
+        return self.success_share if len(self.successes) >= self.window else None
+
     def add(self, episode_return: float, success: bool | None = None, counted: bool = True) -> dict:
         """Record one episode; return the article's per-episode metrics (and success, when given).
         An episode not ``counted`` (it started elsewhere than evaluations do) logs its return and

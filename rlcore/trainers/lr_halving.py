@@ -3,8 +3,8 @@
 Mario 2-1 held at a 30-36 % flag share for 280 rollouts at Adam 1e-4, with approx KL ~0.022 per update;
 a resume at 5e-5 took it to 45 % within 20 rollouts, another at 2.5e-5 to 58 %. Each was a manual stop
 and resume. This does the same by rule: the rate is ``--lr`` x 0.5^k, where k counts the marks that the
-best success share so far has reached. The share is the stop rule's (the last ``window`` counted
-episodes), read only once the window is full, so a lucky first few episodes do not count.
+best success share so far has reached. The share is the stop rule's,
+:attr:`~rlcore.trainers.episodes.EpisodeBook.settled_success_share` (none until the window is full).
 
 The best share is kept in the checkpoint, so a resume comes back at the same rate; a resume's
 ``--lr`` is the rate before any halving.
@@ -15,8 +15,8 @@ from __future__ import annotations
 class LearningRateHalving:
     STATE_KEY = "best_success_share"
 
-    def __init__(self, lr: float, marks: tuple[float, ...], window: int, state: dict | None = None):
-        self.base, self.marks, self.window = lr, tuple(sorted(marks)), window
+    def __init__(self, lr: float, marks: tuple[float, ...], state: dict | None = None):
+        self.base, self.marks = lr, tuple(sorted(marks))
         self.best = float((state or {}).get(self.STATE_KEY, 0.0))
 
     def halvings(self) -> int:
@@ -25,10 +25,10 @@ class LearningRateHalving:
     def rate(self) -> float:
         return self.base * 0.5 ** self.halvings()
 
-    def observe(self, successes: list, share: float) -> str | None:
-        """After a rollout: note the share (``book.successes``, ``book.success_share``); return a line
-        for the console when the rate changed, else None."""
-        if not self.marks or len(successes) < self.window or share <= self.best:
+    def observe(self, share: float | None) -> str | None:
+        """After a rollout: note the share (``book.settled_success_share``; None before the window is
+        full); return a line for the console when the rate changed, else None."""
+        if not self.marks or share is None or share <= self.best:
             return None
         before = self.rate()
         self.best = share

@@ -64,7 +64,7 @@ def train(spec: RunSpec) -> Path:
     session = TrainingSession(spec, state, progress_unit="step")
     book = session.book
     rollouts = int(state.get("rollouts", 0)) if state else 0
-    lr = LearningRateHalving(cfg.lr, cfg.lr_halve_at, cfg.window, state)
+    lr = LearningRateHalving(cfg.lr, cfg.lr_halve_at, state)
     agent.set_learning_rate(lr.rate())  # a resume comes back at the rate its halvings left
 
     env_kept = {}  # what the envs built up (Mario: the restart routes), read while the pool is open
@@ -109,7 +109,7 @@ def train(spec: RunSpec) -> Path:
             session.log_rollout(rollouts, {**log.row(), **losses, "lr": lr.rate()})
             line = log.line(rollouts, session.env_steps, book, cfg.window)
             tqdm.write(line + f" | loss {losses['loss']:.3f} entropy {losses['entropy']:.2f}")
-            halved = lr.observe(book.successes, book.success_share)
+            halved = lr.observe(book.settled_success_share)
             if halved:
                 agent.set_learning_rate(lr.rate())
                 tqdm.write(halved)

@@ -86,8 +86,8 @@ class StopRules:
             return f"max_env_steps {cfg.max_env_steps}"
         if evaluation.reached_stop_score():
             return f"stop_eval_score {evaluation.stop_score}"
-        if self.success_share and len(book.successes) >= cfg.window \
-                and book.success_share >= self.success_share:
+        share = book.settled_success_share
+        if self.success_share and share is not None and share >= self.success_share:
             return f"stop_success_share {self.success_share}"
         if book.full_window() and book.average >= cfg.stop_score:
             return f"stop_score {cfg.stop_score}"

@@ -9,6 +9,7 @@ import pytest
 from rlcore.configs import PPOConfig
 from rlcore.errors import UserError
 from rlcore.trainers import ppo as ppo_trainer
+from rlcore.trainers.episodes import EpisodeBook
 from rlcore.trainers.lr_halving import LearningRateHalving
 from rlcore.trainers.spec import CHECKPOINT_FILE
 from tests import toy
@@ -17,18 +18,22 @@ pytestmark = pytest.mark.usefixtures("toy_experiments")
 
 
 def test_each_mark_halves_once_and_only_with_a_full_window():
-    lr = LearningRateHalving(1e-4, (0.45, 0.3), window=4)
-    assert lr.observe([True] * 3, 1.0) is None and lr.rate() == 1e-4  # window not full yet
-    assert lr.observe([False, True, False, False], 0.25) is None and lr.rate() == 1e-4
-    assert "0.0001 -> 5e-05" in lr.observe([True] * 4, 0.35)  # only the list's length is read
-    assert lr.observe([False] * 4, 0.0) is None and lr.rate() == 5e-5  # a fall does not raise it back
-    assert lr.observe([True, False, False, False], 0.25) is None and lr.rate() == 5e-5  # nor a return
-    assert "5e-05 -> 2.5e-05" in lr.observe([True, True, False, True], 0.75)
-    assert lr.observe([True] * 4, 1.0) is None and lr.rate() == 2.5e-5  # no mark left
+    book = EpisodeBook(window=4, solved_score=None)
+    for won in (True, True, True):
+        book.add(0.0, won)
+    assert book.settled_success_share is None  # window not full yet
+    lr = LearningRateHalving(1e-4, (0.45, 0.3))
+    assert lr.observe(book.settled_success_share) is None and lr.rate() == 1e-4
+    assert lr.observe(0.25) is None and lr.rate() == 1e-4
+    assert "0.0001 -> 5e-05" in lr.observe(0.35)
+    assert lr.observe(0.0) is None and lr.rate() == 5e-5  # a fall does not raise it back
+    assert lr.observe(0.25) is None and lr.rate() == 5e-5  # nor a return
+    assert "5e-05 -> 2.5e-05" in lr.observe(0.75)
+    assert lr.observe(1.0) is None and lr.rate() == 2.5e-5  # no mark left
     # a resume from the kept state comes back at the same rate; --lr is the rate before halving
-    again = LearningRateHalving(2e-4, (0.3, 0.45), 4, lr.state())
+    again = LearningRateHalving(2e-4, (0.3, 0.45), lr.state())
     assert again.rate() == pytest.approx(5e-5)
-    assert LearningRateHalving(1e-4, (), 4).state() == {}
+    assert LearningRateHalving(1e-4, ()).state() == {}
 
 
 @pytest.mark.parametrize("marks", [(0.0,), (1.5,), (0.3, float("nan"))])
