@@ -5,6 +5,7 @@ import pytest
 
 from mario_ppo.env import FRAME_SIZE, ClassicReward, SkipAndHistory, SkipAndStack, classic_reward, gray_84, make_env
 from mario_ppo.episode_ends import DeadEnds, StallLimit
+from tests.mario_ppo.scripted import ScriptedInfos
 from rlcore.errors import UserError
 
 RIGHT = 1  # SIMPLE_MOVEMENT[1] == ['right']
@@ -113,24 +114,8 @@ def test_classic_reward_rules():
     assert classic_reward(104, 100, 399, 400, True) == -15  # 4 - 1 - 25 = -22, clipped to -15
 
 
-class _ScriptedInfos(gym.Env):
-    """A stand-in emulator that replays a list of infos (x, clock, score, dying)."""
-    observation_space, action_space = gym.spaces.Discrete(1), gym.spaces.Discrete(1)
-
-    def __init__(self, infos):
-        self.infos = [dict(x_pos=x, time=t, score=sc, is_dying=d, is_dead=False) for x, t, sc, d in infos]
-
-    def reset(self, *, seed=None, options=None):
-        self.i = 0
-        return 0, self.infos[0]
-
-    def step(self, action):
-        self.i += 1
-        return 0, 123.0, False, False, self.infos[self.i]
-
-
 def _classic_rewards(infos, score_reward):
-    env = ClassicReward(_ScriptedInfos(infos), score_reward)
+    env = ClassicReward(ScriptedInfos(infos), score_reward)
     env.reset()
     return [env.step(0)[1] for _ in infos[1:]]
 
@@ -140,55 +125,6 @@ def test_score_reward_adds_the_change_of_the_game_score():
     assert _classic_rewards(infos, 0.0) == [3, 0, -15]  # the article's reward ignores the score
     # uvipen's 1/40: +2.5 for a 100-point stomp, +5 for 200 points, added after the clip
     assert _classic_rewards(infos, 0.025) == [3 + 2.5, 0, -15 + 5]
-
-
-def test_stall_limit_truncates_after_steps_without_a_new_best_x():
-    xs = [100, 101, 102, 102, 90, 102, 103, 103, 103, 103]
-    env = StallLimit(_ScriptedInfos([(x, 400, 0, False) for x in xs]), steps=3)
-    env.reset()
-    steps = [env.step(0) for _ in xs[1:]]
-    # best x 102 at step 2; steps 3, 4, 5 bring nothing new -> truncated at step 5; 103 resets the count
-    assert [s[3] for s in steps] == [False, False, False, False, True, False, False, False, True]
-    assert not any(s[2] for s in steps)  # a truncation, never a termination (PPO bootstraps it)
-
-
-def test_a_stall_can_end_as_a_death_with_the_end_penalty():
-    xs = [100, 101, 101, 101, 101]
-    env = StallLimit(_ScriptedInfos([(x, 400, 0, False) for x in xs]), steps=3, outcome="death")
-    env.reset()
-    steps = [env.step(0) for _ in xs[1:]]
-    assert [s[2] for s in steps] == [False, False, False, True] and not any(s[3] for s in steps)
-    assert steps[-1][1] == 123.0 - 5.0  # the stand-in's reward, then -50 / 10 as at any other death
-    assert steps[0][1] == 123.0
-
-
-class _ScriptedPlaces(_ScriptedInfos):
-    """The stand-in with an area type in RAM 0x074E, as the emulator keeps it."""
-
-    def __init__(self, places):
-        super().__init__([(x, 400, 0, False) for x, _ in places])
-        self.areas = [area for _, area in places]
-        self.ram = np.zeros(2048, np.uint8)
-
-    def step(self, action):
-        out = super().step(action)
-        self.ram[0x074E] = self.areas[self.i]
-        return out
-
-
-def test_a_dead_end_of_the_level_ends_as_a_death():
-    # 1-2: underground past x 2,750 is the ceiling route to the warp zone; the exit pipe leads
-    # overworld (area 1), where x 2,872 and on is the way to the flag
-    places = [(2600, 2), (2740, 2), (2872, 1), (2930, 1), (2751, 2)]
-    env = DeadEnds(_ScriptedPlaces(places), world=1, stage=2)
-    env.reset()
-    steps = [env.step(0) for _ in places[1:]]
-    assert [s[2] for s in steps] == [False, False, False, True]
-    assert [s[4]["dead_end"] for s in steps] == [False, False, False, True]
-    assert steps[-1][1] == 123.0 - 5.0 and steps[0][1] == 123.0
-    other_level = DeadEnds(_ScriptedPlaces(places), world=1, stage=1)  # no rule: nothing changes
-    other_level.reset()
-    assert not any(other_level.step(0)[2] for _ in places[1:])
 
 
 def test_unknown_level_action_set_and_frame_stack_are_clear_errors():
