@@ -33,8 +33,8 @@ class StallLimit(gym.Wrapper):
     A pipe into another area puts Mario at that area's own x, which can be far behind the best x
     of the area he left; the count then starts over from there (:data:`WARP_DROP`). Seen on 2-2: the
     exit pipe at x 3,010 leads out of the water to x 2,872, some 140 short of the best, and the
-    pipe's own animation takes 11 agent steps, so without this every Mario who found the pipe was
-    ended as stalled on the staircase to the flag.
+    pipe's own animation takes 11 agent steps, so a Mario who found the pipe had the rest of a
+    40-step count to climb the staircase past x 3,010 (before this, no training episode did).
     """
     OUTCOMES = ("truncate", "death")
 
