@@ -5,8 +5,8 @@ import pytest
 
 from mario_ppo.env import FRAME_SIZE, ClassicReward, SkipAndHistory, SkipAndStack, classic_reward, gray_84, make_env
 from mario_ppo.episode_ends import DeadEnds, StallLimit
-from tests.mario_ppo.scripted import ScriptedInfos
 from rlcore.errors import UserError
+from tests.mario_ppo.scripted import ScriptedInfos
 
 RIGHT = 1  # SIMPLE_MOVEMENT[1] == ['right']
 
