@@ -11,6 +11,7 @@ Measurements:
   pool          agent steps/s of the env pool, processes over Pipes vs inline, with 1, 2, 4, 8 envs
   act           one batched action for 8 envs (compiled CNN forward + numpy sampling)
   update        one PPO update (10 epochs x 16 minibatches of 256 over 512 x 8), seconds
+                (act, update and train run once per --precision: float32 and bfloat16 by default)
   train         end-to-end env steps/s and emulator frames/s of the default preset over N rollouts
 """
 from __future__ import annotations
@@ -69,10 +70,11 @@ def bench_pool(seconds: float):
                  agent_steps_per_s=round(vector_steps * n / elapsed, 1))
 
 
-def bench_agent():
+def bench_agent(precision: str):
     from rlcore.agents.ppo import PPOAgent
 
-    agent = PPOAgent((84, 84, 4), 7, CFG)
+    cfg = dataclasses.replace(CFG, precision=precision)
+    agent = PPOAgent((84, 84, 4), 7, cfg)
     rng = np.random.default_rng(0)
     obs = rng.integers(0, 256, (8, 84, 84, 4), dtype=np.uint8)
     for _ in range(5):
@@ -80,8 +82,8 @@ def bench_agent():
     start, n = time.perf_counter(), 100
     for _ in range(n):
         agent.act(obs, rng)
-    emit(bench="act", num_envs=8, ms=round((time.perf_counter() - start) / n * 1e3, 2))
-    t, m = CFG.n_steps, CFG.num_envs
+    emit(bench="act", precision=precision, num_envs=8, ms=round((time.perf_counter() - start) / n * 1e3, 2))
+    t, m = cfg.n_steps, cfg.num_envs
     rollout = (rng.integers(0, 256, (t, m, 84, 84, 4), dtype=np.uint8), rng.integers(0, 7, (t, m)).astype(np.int32),
                *(rng.normal(size=(t, m)).astype(np.float32) for _ in range(4)),
                np.zeros((t, m), np.float32), np.zeros((t, m), np.float32))
@@ -90,22 +92,22 @@ def bench_agent():
     first = time.perf_counter() - start
     start = time.perf_counter()
     agent.update(*rollout, rng)
-    emit(bench="update", transitions=t * m, epochs=CFG.epochs, minibatch=CFG.minibatch,
+    emit(bench="update", precision=precision, transitions=t * m, epochs=cfg.epochs, minibatch=cfg.minibatch,
          first_call_s=round(first, 1), seconds=round(time.perf_counter() - start, 1))
 
 
-def bench_train(rollouts: int):
+def bench_train(rollouts: int, precision: str):
     from rlcore.trainers import ppo
     from rlcore.trainers.spec import RunSpec
 
     steps = rollouts * CFG.n_steps * CFG.num_envs
-    cfg = dataclasses.replace(CFG, max_env_steps=steps)
+    cfg = dataclasses.replace(CFG, max_env_steps=steps, precision=precision)
     spec = RunSpec(EXPERIMENT, "ppo", "default", cfg, 0, "off", Path(tempfile.mkdtemp(prefix="bench_")),
                    command="benchmark", progress=False)
     with contextlib.redirect_stdout(sys.stderr):
         model_dir = ppo.train(spec)
     meta = json.loads((model_dir / "meta.json").read_text())
-    emit(bench="train", rollouts=rollouts, env_steps=meta["env_steps"], wall_seconds=meta["wall_seconds"],
+    emit(bench="train", precision=precision, rollouts=rollouts, env_steps=meta["env_steps"], wall_seconds=meta["wall_seconds"],
          env_steps_per_s=round(meta["env_steps"] / meta["wall_seconds"], 1),
          frames_per_s=round(4 * meta["env_steps"] / meta["wall_seconds"], 1))
 
@@ -115,13 +117,18 @@ def main():
     parser.add_argument("--seconds", type=float, default=5.0, help="per env/pool measurement")
     parser.add_argument("--train-rollouts", type=int, default=0, help="also time N rollouts of training")
     parser.add_argument("--skip-pool", action="store_true")
+    parser.add_argument("--skip-env", action="store_true", help="no emulator or wrapped-env rates")
+    parser.add_argument("--precision", nargs="+", default=["float32", "bfloat16"], choices=["float32", "bfloat16"],
+                        help="the CNN's compute precision(s) for act, update and train, side by side")
     args = parser.parse_args()
-    bench_emulator(args.seconds)
+    if not args.skip_env:
+        bench_emulator(args.seconds)
     if not args.skip_pool:
         bench_pool(args.seconds)
-    bench_agent()
-    if args.train_rollouts:
-        bench_train(args.train_rollouts)
+    for precision in args.precision:
+        bench_agent(precision)
+    for precision in args.precision if args.train_rollouts else ():
+        bench_train(args.train_rollouts, precision)
 
 
 if __name__ == "__main__":

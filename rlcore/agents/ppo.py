@@ -39,16 +39,22 @@ MODEL_FILE = "actor_critic.h5"
 _QUIRK_EPS = 1e-3  # the article's constant in pi / (pi_old + 1e-3) and log(pi + 1e-3)
 
 
-def build_actor_critic(obs_shape: tuple, n_actions: int) -> keras.Model:
-    """Feature: 4 x Conv2D(32, 3, stride 2, same, ReLU) -> Flatten -> Dense 512; then two heads."""
+def build_actor_critic(obs_shape: tuple, n_actions: int, precision: str = "float32") -> keras.Model:
+    """Feature: 4 x Conv2D(32, 3, stride 2, same, ReLU) -> Flatten -> Dense 512; then two heads.
+
+    ``precision="bfloat16"`` makes the feature layers compute in bfloat16 (Keras's mixed_bfloat16
+    policy: their weights stay float32). The two heads always compute in float32, so logits, values
+    and every loss built on them are float32.
+    """
+    body = "mixed_bfloat16" if precision == "bfloat16" else "float32"
     frames = keras.Input(obs_shape, dtype="uint8", name="frames")
-    x = layers.Rescaling(1.0 / 255.0, name="to_unit")(frames)
+    x = layers.Rescaling(1.0 / 255.0, name="to_unit", dtype=body)(frames)
     for i in range(4):
-        x = layers.Conv2D(32, 3, strides=2, padding="same", activation="relu", name=f"conv_{i}")(x)
-    x = layers.Flatten(name="flatten")(x)
-    x = layers.Dense(512, activation="relu", name="feature")(x)
-    logits = layers.Dense(n_actions, name="policy_logits")(x)
-    value = layers.Dense(1, name="value")(x)
+        x = layers.Conv2D(32, 3, strides=2, padding="same", activation="relu", name=f"conv_{i}", dtype=body)(x)
+    x = layers.Flatten(name="flatten", dtype=body)(x)
+    x = layers.Dense(512, activation="relu", name="feature", dtype=body)(x)
+    logits = layers.Dense(n_actions, name="policy_logits", dtype="float32")(x)
+    value = layers.Dense(1, name="value", dtype="float32")(x)
     return keras.Model(frames, [logits, value], name="actor_critic")
 
 
@@ -98,7 +104,7 @@ class PPOAgent:
 
     def __init__(self, obs_shape: tuple, n_actions: int, cfg: PPOConfig):
         self.obs_shape, self.n_actions, self.cfg = tuple(obs_shape), n_actions, cfg
-        self.model = build_actor_critic(self.obs_shape, n_actions)
+        self.model = build_actor_critic(self.obs_shape, n_actions, cfg.precision)
         self.opt = keras.optimizers.Adam(cfg.lr)
         self.opt.build(self.model.trainable_variables)
         frames = tf.TensorSpec([None, *self.obs_shape], tf.uint8)

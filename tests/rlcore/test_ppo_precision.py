@@ -1,0 +1,74 @@
+"""PPO's ``precision="bfloat16"``: the feature layers compute in bfloat16, everything else stays float32,
+and an update lands where the float32 update lands, much closer than the update itself moves."""
+import dataclasses
+
+import numpy as np
+import tensorflow as tf
+
+from rlcore.agents.ppo import PPOAgent
+from rlcore.checkpoint import load_checkpoint, save_checkpoint
+from rlcore.models import load_keras_model
+from tests.rlcore.test_ppo import CFG, OBS, _rollout
+
+BF16 = dataclasses.replace(CFG, precision="bfloat16")
+
+
+def _kl(p, q):
+    return float(np.mean(np.sum(p * (np.log(p) - np.log(q)), axis=1)))
+
+
+def _pair():
+    tf.keras.utils.set_random_seed(7)
+    full, half = PPOAgent(OBS, 5, CFG), PPOAgent(OBS, 5, BF16)
+    half.model.set_weights(full.model.get_weights())
+    return full, half
+
+
+def test_only_the_feature_layers_compute_in_bfloat16():
+    _, half = _pair()
+    computes = {layer.name: layer.compute_dtype for layer in half.model.layers[1:]}
+    assert computes.pop("policy_logits") == computes.pop("value") == "float32"
+    assert set(computes.values()) == {"bfloat16"}, computes
+    assert {w.dtype for w in half.model.get_weights()} == {np.dtype("float32")}  # Adam steps float32 weights
+    logits, values = half._forward(np.zeros((2, *OBS), np.uint8))
+    assert logits.dtype == values.dtype == tf.float32
+
+
+def test_bfloat16_policy_and_update_track_float32():
+    full, half = _pair()
+    rollout = list(_rollout(np.random.default_rng(4)))
+    obs = rollout[0].reshape(-1, *OBS)
+    before, _ = full.policy_and_values(obs)
+    rounded, _ = half.policy_and_values(obs)
+    assert 0 < _kl(before, rounded) < 1e-4  # rounded (not the float32 path by mistake), and barely
+    rollout[2] = np.log(before[np.arange(len(obs)), rollout[1].ravel()]).reshape(rollout[1].shape).astype(np.float32)
+    report_full = full.update(*rollout, np.random.default_rng(5))
+    report_half = half.update(*rollout, np.random.default_rng(5))
+    after_full, _ = full.policy_and_values(obs)
+    after_half, _ = half.policy_and_values(obs)
+    moved = _kl(before, after_full)
+    assert moved > 1e-3  # the update did move the policy, so the comparison below means something
+    assert _kl(after_full, after_half) < 0.1 * moved, (_kl(after_full, after_half), moved)
+    for name in ("policy_loss", "entropy", "approx_kl"):
+        assert abs(report_full[name] - report_half[name]) < 0.1 * abs(report_full[name]) + 1e-3, name
+
+
+def test_a_float32_checkpoint_resumes_in_bfloat16(tmp_path):
+    """``--resume ... --precision bfloat16`` on a run trained in float32: the same weights and Adam state."""
+    full, half = _pair()
+    full.update(*_rollout(np.random.default_rng(0)), np.random.default_rng(0))
+    save_checkpoint(tmp_path / "c.npz", full.models(), full.optimizers(), {})
+    load_checkpoint(tmp_path / "c.npz", half.models(), half.optimizers())
+    for a, b in zip(full.model.get_weights(), half.model.get_weights()):
+        np.testing.assert_array_equal(a, b)
+    assert int(half.opt.iterations) == int(full.opt.iterations) > 0
+
+
+def test_a_bfloat16_model_saves_and_loads_as_trained(tmp_path):
+    _, half = _pair()
+    path = half.save(tmp_path)[0]
+    loaded = load_keras_model(path, OBS, 5)
+    assert loaded.get_layer("feature").compute_dtype == "bfloat16"
+    obs = np.random.default_rng(1).integers(0, 256, (3, *OBS), dtype=np.uint8)
+    for got, want in zip(loaded(obs), half.model(obs)):
+        np.testing.assert_array_equal(np.asarray(got), np.asarray(want))
