@@ -7,6 +7,7 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 from rlcore.atomic import write_json
+from rlcore.cpu import cpu_description
 from rlcore.plotting import plot_run
 
 
@@ -22,28 +23,6 @@ def package_versions() -> dict:
         except PackageNotFoundError:
             pass
     return found
-
-
-SIMD_FLAGS = ("avx2", "fma", "avx512f", "avx512_bf16", "amx_tile")  # what oneDNN picks its code paths by
-
-
-def cpu_description(cpuinfo: Path = Path("/proc/cpuinfo")) -> str:
-    """The CPU a run trained on, e.g. ``AMD EPYC (avx2 fma avx512f)``. A seed repeats a run bit for bit
-    on one machine, but TensorFlow's oneDNN kernels order float sums by the CPU's vector units, so the
-    same seed on another CPU can drift (seen on LunarLander's dueling runs); meta.json says which."""
-    try:
-        text = cpuinfo.read_text()
-    except OSError:
-        text = ""
-    first = {}  # the first core's fields
-    for line in text.splitlines():
-        if ":" in line:
-            key, value = (part.strip() for part in line.split(":", 1))
-            first.setdefault(key, value)
-    name = first.get("model name") or platform.processor() or platform.machine() or "unknown"
-    flags = set(first.get("flags", "").split())
-    simd = [f for f in SIMD_FLAGS if f in flags]
-    return f"{name} ({' '.join(simd)})" if simd else name
 
 
 def write_model_folder(run_dir: Path, experiment, describe: dict, save_models, record: dict) -> Path:

@@ -14,6 +14,7 @@ import numpy as np
 from tqdm import tqdm
 
 from rlcore.agents.ppo import MODEL_FILE, UPDATE_NAMES, PPOAgent
+from rlcore.cpu import bfloat16_note, cpu_flags
 from rlcore.errors import UserError
 from rlcore.trainers import checkpoints
 from rlcore.trainers.divergence import reported_divergence
@@ -53,6 +54,8 @@ def train(spec: RunSpec) -> Path:
     envs = EnvPool([make_env] * cfg.num_envs, mode=cfg.vec)
     obs_shape, n_actions = envs.single_observation_space.shape, int(envs.single_action_space.n)
     agent = PPOAgent(obs_shape, n_actions, cfg)
+    if note := bfloat16_note(cfg.precision, cpu_flags()):
+        tqdm.write(note)
     rng = np.random.default_rng(spec.seed)
 
     state, arrays = checkpoints.restore(spec, agent, rng)

@@ -1,8 +1,10 @@
 """PPO's ``precision="bfloat16"``: the feature layers compute in bfloat16, everything else stays float32,
 and an update lands where the float32 update lands, much closer than the update itself moves."""
 import dataclasses
+import json
 
 import numpy as np
+import pytest
 import tensorflow as tf
 
 from rlcore.agents.ppo import PPOAgent
@@ -72,3 +74,18 @@ def test_a_bfloat16_model_saves_and_loads_as_trained(tmp_path):
     obs = np.random.default_rng(1).integers(0, 256, (3, *OBS), dtype=np.uint8)
     for got, want in zip(loaded(obs), half.model(obs)):
         np.testing.assert_array_equal(np.asarray(got), np.asarray(want))
+
+
+@pytest.mark.usefixtures("toy_experiments")
+def test_a_bfloat16_run_trains_and_notes_a_cpu_without_amx(tmp_path, monkeypatch, capsys):
+    from rlcore.trainers import ppo as ppo_trainer
+    from tests import toy
+
+    for flags, noted in (({"avx2"}, True), ({"avx2", "amx_bf16"}, False)):
+        monkeypatch.setattr(ppo_trainer, "cpu_flags", lambda flags=flags: flags)
+        folder = tmp_path / str(noted)
+        meta = json.loads((ppo_trainer.train(toy.spec("ppo", folder, max_env_steps=64, stop_success_share=0.0,
+                                                      precision="bfloat16")) / "meta.json").read_text())
+        assert meta["config"]["precision"] == "bfloat16"
+        out = capsys.readouterr().out
+        assert ("note: --precision bfloat16 was measured faster only on CPUs with amx_bf16" in out) is noted

@@ -14,7 +14,7 @@ from rlcore.policies import load_policy
 from rlcore.trainers import a2c as a2c_trainer
 from rlcore.trainers import ppo as ppo_trainer
 from rlcore.trainers import sac as sac_trainer
-from rlcore.trainers.model_folder import cpu_description
+from rlcore.cpu import cpu_description
 from tests import toy
 from tests.toy import TRAINERS
 

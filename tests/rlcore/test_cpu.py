@@ -1,5 +1,6 @@
-"""meta.json's record of the machine: the CPU line read from /proc/cpuinfo."""
-from rlcore.trainers.model_folder import cpu_description
+"""What /proc/cpuinfo tells: meta.json's CPU line, and the bfloat16 note (said once where bfloat16 was
+never measured faster, and nowhere else)."""
+from rlcore.cpu import bfloat16_note, cpu_description, cpu_flags
 
 CORE = """processor\t: {n}
 vendor_id\t: GenuineIntel
@@ -27,3 +28,27 @@ def test_no_cpuinfo_falls_back_to_the_platform(tmp_path, monkeypatch):
     monkeypatch.setattr("platform.processor", lambda: "")  # Linux often says nothing here
     monkeypatch.setattr("platform.machine", lambda: "aarch64")
     assert cpu_description(tmp_path / "missing") == "aarch64"
+
+
+CPUINFO = """processor\t: 0
+vendor_id\t: GenuineIntel
+flags\t\t: fpu sse2 avx2 avx512f amx_tile amx_bf16
+bugs\t\t: spectre_v1
+processor\t: 1
+flags\t\t: fpu
+"""
+
+
+def test_flags_come_from_the_first_processor(tmp_path):
+    (tmp_path / "cpuinfo").write_text(CPUINFO)
+    assert cpu_flags(tmp_path / "cpuinfo") == {"fpu", "sse2", "avx2", "avx512f", "amx_tile", "amx_bf16"}
+    (tmp_path / "bare").write_text("processor\t: 0\n")
+    assert cpu_flags(tmp_path / "bare") is None
+    assert cpu_flags(tmp_path / "missing") is None
+
+
+def test_the_note_appears_only_for_bfloat16_without_amx():
+    assert bfloat16_note("bfloat16", {"avx2", "avx512_bf16"}).startswith("note: --precision bfloat16")
+    assert bfloat16_note("bfloat16", {"avx2", "amx_bf16"}) is None
+    assert bfloat16_note("float32", {"avx2"}) is None
+    assert bfloat16_note("bfloat16", None) is None  # flags unknown (not Linux): no claim either way

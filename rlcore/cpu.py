@@ -1,0 +1,50 @@
+"""The CPU a run trains on, read from /proc/cpuinfo (Linux): its name and vector units for meta.json,
+and whether ``--precision bfloat16`` was ever measured faster on such a CPU."""
+from __future__ import annotations
+
+import platform
+from pathlib import Path
+
+CPUINFO = Path("/proc/cpuinfo")
+SIMD_FLAGS = ("avx2", "fma", "avx512f", "avx512_bf16", "amx_tile")  # what oneDNN picks its code paths by
+BFLOAT16_MATMUL = "amx_bf16"  # the only such CPU flag bfloat16 was measured faster with (README, Speed)
+
+
+def first_cpu_fields(cpuinfo: str | Path = CPUINFO) -> dict[str, str]:
+    """The first core's ``key: value`` fields; empty where the file cannot be read."""
+    try:
+        text = Path(cpuinfo).read_text()
+    except OSError:
+        return {}
+    first = {}
+    for line in text.splitlines():
+        if ":" in line:
+            key, value = (part.strip() for part in line.split(":", 1))
+            first.setdefault(key, value)
+    return first
+
+
+def cpu_flags(cpuinfo: str | Path = CPUINFO) -> set[str] | None:
+    """The first core's flags, or None where they cannot be read (no claim either way then)."""
+    flags = first_cpu_fields(cpuinfo).get("flags")
+    return set(flags.split()) if flags is not None else None
+
+
+def cpu_description(cpuinfo: str | Path = CPUINFO) -> str:
+    """The CPU a run trained on, e.g. ``AMD EPYC (avx2 fma avx512f)``. A seed repeats a run bit for bit
+    on one machine, but TensorFlow's oneDNN kernels order float sums by the CPU's vector units, so the
+    same seed on another CPU can drift (seen on LunarLander's dueling runs); meta.json says which."""
+    first = first_cpu_fields(cpuinfo)
+    name = first.get("model name") or platform.processor() or platform.machine() or "unknown"
+    flags = set(first.get("flags", "").split())
+    simd = [f for f in SIMD_FLAGS if f in flags]
+    return f"{name} ({' '.join(simd)})" if simd else name
+
+
+def bfloat16_note(precision: str, flags: set[str] | None) -> str | None:
+    """One console line when a run computes in bfloat16 on a CPU where that was never measured faster."""
+    if precision != "bfloat16" or flags is None or BFLOAT16_MATMUL in flags:
+        return None
+    return (f"note: --precision bfloat16 was measured faster only on CPUs with {BFLOAT16_MATMUL}, which this "
+            "one lacks; `python benchmarks/mario.py --skip-env --skip-pool` compares both precisions here, "
+            "and a resume with --precision float32 switches back")
