@@ -107,7 +107,8 @@ def bench_train(rollouts: int, precision: str):
     with contextlib.redirect_stdout(sys.stderr):
         model_dir = ppo.train(spec)
     meta = json.loads((model_dir / "meta.json").read_text())
-    emit(bench="train", precision=precision, rollouts=rollouts, env_steps=meta["env_steps"], wall_seconds=meta["wall_seconds"],
+    emit(bench="train", precision=precision, rollouts=rollouts, env_steps=meta["env_steps"],
+         wall_seconds=meta["wall_seconds"],
          env_steps_per_s=round(meta["env_steps"] / meta["wall_seconds"], 1),
          frames_per_s=round(4 * meta["env_steps"] / meta["wall_seconds"], 1))
 
