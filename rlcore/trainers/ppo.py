@@ -7,6 +7,7 @@ article's console line; :class:`RolloutLog`).
 """
 from __future__ import annotations
 
+import time
 from pathlib import Path
 
 import keras
@@ -86,6 +87,7 @@ def train(spec: RunSpec) -> Path:
         while not session.should_stop():
             log = RolloutLog(exp)
             truncated_values = {}
+            started = time.perf_counter()
             for step in range(t):
                 actions, logp, values = agent.act(obs, rng)
                 next_obs, rewards, terminated, truncated, infos = envs.step(actions)
@@ -106,10 +108,13 @@ def train(spec: RunSpec) -> Path:
                 obs = next_obs
                 session.advance(n)
             buf.close(agent.values(obs), truncated_values)
+            collected = time.perf_counter()
             with reported_divergence(session, "PPO", "lower --lr"):
                 losses = agent.update(*buf.arrays(), rng)
             rollouts += 1
-            session.log_rollout(rollouts, {**log.row(), **losses, "lr": lr.rate()})
+            seconds = {"collect_seconds": round(collected - started, 3),  # where a rollout's time goes
+                       "update_seconds": round(time.perf_counter() - collected, 3)}
+            session.log_rollout(rollouts, {**log.row(), **losses, "lr": lr.rate(), **seconds})
             line = log.line(rollouts, session.env_steps, book, cfg.window)
             tqdm.write(line + f" | loss {losses['loss']:.3f} entropy {losses['entropy']:.2f}")
             halved = lr.observe(book.settled_success_share)
