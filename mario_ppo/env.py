@@ -38,7 +38,7 @@ import numpy as np
 ACTION_SETS = ("simple", "complex", "right_only")
 FRAME_STACKS = ("skipped", "history")
 FRAME_SIZE = 84
-INFO_KEYS = ("x_pos", "flag_get", "time", "world", "stage", "restarted")  # what the wrappers pass on
+INFO_KEYS = ("x_pos", "flag_get", "time", "world", "stage", "restarted", "start_x")  # what the wrappers pass on
 
 
 def action_list(name: str) -> list:

@@ -111,6 +111,6 @@ EXPERIMENT = Experiment(
     env_fields=("world", "stage", "actions", "score_reward", "stall_steps", "stall_outcome",
                 "frames", "dead_ends"), train_env_fields=("restart_x", "restart_every", "restart_share"),
     success_key="flag_get", progress_key="x_pos", partial_key="restarted", env_memory="restart_routes",
-    info_keys=("stalled",),
+    info_keys=("stalled", "start_x"),
     eval_episodes=10, ship_by=("world", "stage"), default_model="1-1", score_label="return (shaped, /10)",
 )

@@ -14,7 +14,8 @@ near ones.
 
 Evaluation never uses it: both are training-only settings (``Experiment.train_env_fields``), so
 every evaluation and video starts at the level's start. Restarted episodes are marked
-(``info["restarted"]``) and left out of the flag share that the stop rule reads.
+(``info["restarted"]``) and left out of the flag share that the stop rule reads; ``info["start_x"]``
+says where each episode started (metrics.csv: which points are hard).
 
 A kept point is an emulator state and its route: the buttons, one per NES frame, that lead to it
 from the level's start (through the routes of the restarts it came from). The emulator is
@@ -50,6 +51,7 @@ class Restarts(gym.Wrapper):
         self._snapshots: dict[int, tuple[object, bytes]] = {}  # point number -> (emulator state, route)
         self._restarted = False
         self._passed = 0
+        self._start_x = 0
         self._route = bytearray()  # this episode's buttons, one per frame, from the level's start
 
     def point(self, x_pos: int) -> int:
@@ -71,7 +73,8 @@ class Restarts(gym.Wrapper):
             obs, info = base.screen, base._get_info()
             self._route = bytearray(route)
         self._passed = self.point(info["x_pos"])
-        info["restarted"] = self._restarted
+        self._start_x = int(info["x_pos"])
+        info["restarted"], info["start_x"] = self._restarted, self._start_x
         return obs, info
 
     def step(self, action):
@@ -82,7 +85,7 @@ class Restarts(gym.Wrapper):
             if not (terminated or truncated or info.get("is_dying")):
                 self._snapshots[reached] = (self.env.unwrapped.dump_state(), bytes(self._route))
             self._passed = reached
-        info["restarted"] = self._restarted
+        info["restarted"], info["start_x"] = self._restarted, self._start_x
         return obs, reward, terminated, truncated, info
 
     @property

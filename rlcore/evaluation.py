@@ -20,7 +20,8 @@ def play_greedy(experiment, policy, episodes: int = 100, seed_base: int | None =
                 info_keys: tuple[str, ...] = ()) -> list[dict]:
     """Play ``episodes`` greedy episodes, episode i seeded ``seed_base + i``; one record per
     episode in seed order: seed, return, length, ``time_limit`` (it lasted until the time limit
-    rather than ending in the env, a fall say) and the final value of each of ``info_keys``.
+    rather than ending in the env, a fall say) and the final value of each of ``info_keys`` that the
+    env reported (a training-only key, such as Mario's ``start_x``, is left out).
 
     ``max_episode_steps=None`` keeps the env's registered time limit; ``make_env()``, when given,
     builds the env instead (a saved model's own level, say).
@@ -50,7 +51,8 @@ def play_greedy(experiment, policy, episodes: int = 100, seed_base: int | None =
         for i in np.flatnonzero((terminated | truncated) & active):
             record = {"seed": slot_seed[i], "return": float(running[i]), "length": int(length[i]),
                       "time_limit": bool(truncated[i] and not terminated[i])}
-            record.update({k: float(final_info(info, k, i, float("nan"))) for k in info_keys})
+            reported = {k: final_info(info, k, i, None) for k in info_keys}
+            record.update({k: float(v) for k, v in reported.items() if v is not None})
             records.append(record)
             running[i], length[i] = 0.0, 0
             bar.update(1)
@@ -71,8 +73,8 @@ def evaluate_success(make_env, act, episodes: int, seed_base: int, success_key: 
     from ``act(obs_batch, rng)`` with ``rng = default_rng(seed_base + i)``.
 
     For envs where success is an event (Mario's flag), not a return. Each record holds the
-    return, the length, whether ``info[success_key]`` was true at the end, and
-    ``info[progress_key]`` there.
+    return, the length, whether ``info[success_key]`` was true at the end, ``info[progress_key]``
+    there, and each of ``info_keys`` the env reported.
     """
     env = make_env()
     records = []
@@ -89,7 +91,7 @@ def evaluate_success(make_env, act, episodes: int, seed_base: int, success_key: 
                       "success": bool(info.get(success_key, False))}
             if progress_key:
                 record[progress_key] = float(info.get(progress_key, float("nan")))
-            record.update({k: float(info.get(k, float("nan"))) for k in info_keys})
+            record.update({k: float(info[k]) for k in info_keys if k in info})
             records.append(record)
             bar.update(1)
             if stop_at_success and record["success"]:

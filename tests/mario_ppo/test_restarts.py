@@ -25,15 +25,18 @@ def test_after_an_episode_passed_x_a_restart_starts_there_and_keeps_that_state()
     try:
         start_obs, info = env.reset(seed=0)
         assert info["restarted"] is False and info["x_pos"] < X  # nothing kept yet: the level's start
+        assert info["start_x"] == info["x_pos"]
         _, passed = _run_right_past(env, X)
+        assert passed["start_x"] == info["x_pos"]  # where the episode began, on every step
         restarts = []
         for seed in (1, 2):
             obs, info = env.reset(seed=seed)
             restarts.append(info["x_pos"])
             assert info["restarted"] is True and X <= info["x_pos"] <= passed["x_pos"]
             assert not np.array_equal(obs, start_obs)  # the screen there, not the level's first frame
+            assert info["start_x"] == restarts[-1]
             _, _, _, _, info = env.step(RIGHT)
-            assert info["restarted"] is True and info["x_pos"] >= restarts[-1]
+            assert info["restarted"] is True and info["x_pos"] >= restarts[-1] == info["start_x"]
             for _ in range(30):  # a restarted episode plays on from there
                 if any(env.step(RIGHT)[2:4]):
                     break

@@ -4,7 +4,7 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-from rlcore.evaluation import evaluate, play_greedy
+from rlcore.evaluation import evaluate, evaluate_success, play_greedy
 from rlcore.experiment import Experiment
 from rlcore.shipping import run_evaluation
 
@@ -42,10 +42,17 @@ ALWAYS_ZERO = lambda obs: np.zeros(len(obs), np.int64)  # noqa: E731
 
 def test_each_record_belongs_to_its_seed_also_when_an_env_plays_a_second_episode():
     # 25 episodes on 20 envs side by side: five envs play a second seed after a short first episode
-    records = play_greedy(EXP, ALWAYS_ZERO, episodes=25, seed_base=100, progress=False, info_keys=("x",))
-    assert records == [expected(s) for s in range(100, 125)]
+    records = play_greedy(EXP, ALWAYS_ZERO, episodes=25, seed_base=100, progress=False, info_keys=("x", "absent"))
+    assert records == [expected(s) for s in range(100, 125)]  # a key the env never reports is left out
     returns = evaluate(EXP, ALWAYS_ZERO, episodes=25, seed_base=100, progress=False)
     np.testing.assert_array_equal(returns, [r["return"] for r in records])
+
+
+def test_success_records_keep_the_info_keys_the_env_reported_and_leave_out_the_others():
+    records = evaluate_success(FallOrWalk, lambda obs, rng: ALWAYS_ZERO(obs), 4, 100, "won", progress=False,
+                               info_keys=("x", "absent"))
+    assert [r["x"] for r in records] == [expected(s)["x"] for s in range(100, 104)]
+    assert not any("absent" in r for r in records)
 
 
 def test_the_summary_counts_the_episodes_that_lasted_to_the_time_limit():
