@@ -128,8 +128,9 @@ def main():
         bench_pool(args.seconds)
     for precision in args.precision:
         bench_agent(precision)
-    for precision in args.precision if args.train_rollouts else ():
-        bench_train(args.train_rollouts, precision)
+    if args.train_rollouts:
+        for precision in args.precision:
+            bench_train(args.train_rollouts, precision)
 
 
 if __name__ == "__main__":

@@ -26,8 +26,11 @@ def first_cpu_fields(cpuinfo: str | Path = CPUINFO) -> dict[str, str]:
 
 def cpu_flags(cpuinfo: str | Path = CPUINFO) -> set[str] | None:
     """The first core's flags, or None where they cannot be read (no claim either way then)."""
-    flags = first_cpu_fields(cpuinfo).get("flags")
-    return set(flags.split()) if flags is not None else None
+    return _flags(first_cpu_fields(cpuinfo))
+
+
+def _flags(fields: dict[str, str]) -> set[str] | None:
+    return set(fields["flags"].split()) if "flags" in fields else None
 
 
 def cpu_description(cpuinfo: str | Path = CPUINFO) -> str:
@@ -36,7 +39,7 @@ def cpu_description(cpuinfo: str | Path = CPUINFO) -> str:
     same seed on another CPU can drift (seen on LunarLander's dueling runs); meta.json says which."""
     first = first_cpu_fields(cpuinfo)
     name = first.get("model name") or platform.processor() or platform.machine() or "unknown"
-    flags = set(first.get("flags", "").split())
+    flags = _flags(first) or set()
     simd = [f for f in SIMD_FLAGS if f in flags]
     return f"{name} ({' '.join(simd)})" if simd else name
 
