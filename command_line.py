@@ -139,7 +139,7 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
                                        "or finished)",
                           description="Write the training plots of a run folder from its CSV tables: score "
                                       "per episode, periodic evaluations; for Mario, x position and flag "
-                                      "share, and a map of where episodes ended.")
+                                      "share, a map of where episodes ended, and what killed Mario.")
     plot.add_argument("run_dir", help="a run folder, e.g. runs/mario_ppo__ppo__0__<time>")
     plot.add_argument("--out", default=None, help="folder for the PNGs (default RUN_DIR/plots)")
     return parser

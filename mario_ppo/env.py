@@ -12,6 +12,9 @@ Stack, innermost first::
     SkipAndStack(4) | SkipAndHistory(4)      one action for 4 frames; as channels, gray 84x84 frames:
                                              the step's 4 (article 001) or one per step for the
                                              last 4 steps (uvipen's), ``frames="history"``
+    KilledBy                                 at a death, what killed Mario: a fall, the clock or
+                                             the nearest enemy (``info["killed_by"]``,
+                                             mario_ppo/deaths.py)
     DeadEnds                                 a known dead end of the level ends as a death (off by
                                              default; mario_ppo/episode_ends.py)
     StallLimit(n)                            truncate once x has not passed its best for n agent
@@ -214,6 +217,7 @@ def make_env(render_mode: str | None = None, max_episode_steps: int | None = Non
     import gym_super_mario_bros  # noqa: F401  registers the SuperMarioBros-* ids
     from nes_py.wrappers import JoypadSpace
 
+    from mario_ppo.deaths import KilledBy
     from mario_ppo.episode_ends import DeadEnds, StallLimit
     from mario_ppo.levels import STAGE, WORLD
     from mario_ppo.restarts import Restarts
@@ -229,7 +233,7 @@ def make_env(render_mode: str | None = None, max_episode_steps: int | None = Non
     if (restart_x or restart_every) and restart_share:
         env = Restarts(env, restart_share, x=restart_x, every=restart_every)
     stack = SkipAndHistory if frames == "history" else SkipAndStack
-    env = stack(ArticleShaping(ClassicReward(env, score_reward)), skip)
+    env = KilledBy(stack(ArticleShaping(ClassicReward(env, score_reward)), skip))
     if dead_ends:
         env = DeadEnds(env, world, stage)
     if stall_steps:

@@ -8,6 +8,7 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass, field
 
+from mario_ppo.deaths import cause_name
 from mario_ppo.env import ACTION_SETS, FRAME_STACKS, make_env
 from mario_ppo.episode_ends import StallLimit
 from mario_ppo.levels import STAGE, WORLD
@@ -111,6 +112,6 @@ EXPERIMENT = Experiment(
     env_fields=("world", "stage", "actions", "score_reward", "stall_steps", "stall_outcome",
                 "frames", "dead_ends"), train_env_fields=("restart_x", "restart_every", "restart_share"),
     success_key="flag_get", progress_key="x_pos", partial_key="restarted", env_memory="restart_routes",
-    info_keys=("stalled", "start_x"),
+    info_keys=("stalled", "start_x", "killed_by"), cause_key="killed_by", cause_name=cause_name,
     eval_episodes=10, ship_by=("world", "stage"), default_model="1-1", score_label="return (shaped, /10)",
 )

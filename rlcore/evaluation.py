@@ -112,3 +112,14 @@ def summarize_success(records: list[dict], progress_key: str | None = None) -> d
         out[f"mean_{progress_key}"] = round(float(np.mean(values)), 1)
         out[f"max_{progress_key}"] = round(float(np.max(values)), 1)
     return out
+
+
+def count_causes(records: list[dict], cause_key: str, cause_name) -> list[tuple[str, int]]:
+    """(cause in words, episodes) over the records that hold ``cause_key``, most first; numbers that
+    ``cause_name`` puts in the same words (Mario: the five Firebar ids) count together."""
+    counts: dict[str, int] = {}
+    for record in records:
+        if record.get(cause_key, float("nan")) == record.get(cause_key):  # present and not NaN
+            name = cause_name(record[cause_key])
+            counts[name] = counts.get(name, 0) + 1
+    return sorted(counts.items(), key=lambda item: -item[1])

@@ -54,6 +54,11 @@ class Experiment:
     # trainers, and in the evaluation's per-episode records (Mario: stalled, 1 when the stall limit
     # ended it; Minitaur: x, metres walked)
     info_keys: tuple[str, ...] = ()
+    # an info key that says, as a number, what ended a failed episode, and the words for a number
+    # (Mario: killed_by, a fall, the clock or an enemy; mario_ppo.deaths.cause_name): the evaluation
+    # line counts its failures by cause, and a Deaths plot shows the causes' shares over training
+    cause_key: str | None = None
+    cause_name: Callable[[float], str] | None = None
     # config fields that make_env takes in training only (Mario: restart_x, ...): the
     # trainer's env pool gets them; evaluations, videos and saved models build the env without them
     train_env_fields: tuple[str, ...] = ()

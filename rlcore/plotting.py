@@ -40,6 +40,9 @@ def plot_run(run_dir: str | Path, out_dir: str | Path, experiment, about: dict) 
                                  experiment.progress_key, window, experiment.partial_key))
         out.append(plot_endings(metrics, out_dir / f"{prefix}_Endings_{algo}.png", title,
                                 experiment.progress_key, experiment.partial_key))
+    if experiment.cause_key and _has_values(metrics, experiment.cause_key):
+        out.append(plot_causes(metrics, out_dir / f"{prefix}_Deaths_{algo}.png", title,
+                               experiment.cause_key, experiment.cause_name))
     if evals.exists():
         out.append(plot_evaluations(evals, out_dir / f"{prefix}_Eval_{algo}.png", title,
                                     experiment.solved_score, label))
@@ -152,6 +155,55 @@ def plot_endings(csv_path: str | Path, png_path: str | Path, title: str, progres
         share.legend(loc="upper left")
     ax.set_title(title)
     return _write(fig, png_path)
+
+
+def cause_shares(causes: pd.Series, block: int, most: int = 6) -> pd.DataFrame:
+    """What ended the failures, over training: the share of each cause (words) among the failures of
+    each block of ``block`` episodes (a row per block, the ``most`` commonest causes, then "other";
+    each row sums to 1, a block without failures is NaN). ``causes`` holds None where an episode did
+    not fail (or before the cause was logged)."""
+    blocks = pd.Series(np.arange(len(causes)) // block, index=causes.index)
+    named = causes.dropna()
+    common = list(named.value_counts().index[:most])
+    named = named.where(named.isin(common), "other")
+    shares = pd.crosstab(blocks[named.index], named, normalize="index")
+    columns = common + (["other"] if "other" in shares.columns else [])
+    shares = shares.reindex(index=range(int(blocks.max()) + 1 if len(blocks) else 0), columns=columns)
+    return shares.rename_axis(index=None, columns=None)
+
+
+def plot_causes(csv_path: str | Path, png_path: str | Path, title: str, cause_key: str, cause_name,
+                blocks: int = 60) -> Path:
+    """What ends the failed episodes (``cause_key``, e.g. Mario's killed_by) over training, as
+    shares of the failures of each block of episodes, from the first episode that logged a cause;
+    restarted episodes included."""
+    df = _table(csv_path, "episode", cause_key)
+    df = df.loc[df[cause_key].first_valid_index():]  # a run resumed by newer code logs it from there on
+    codes = df[cause_key]
+    causes = codes.map(lambda code: cause_name(code) if code == code else None)
+    block = max(20, int(np.ceil(len(df) / blocks)))  # fewer blocks while a few hundred are logged
+    shares = cause_shares(causes, block)
+    starts = df["episode"].to_numpy()[::block][:len(shares)]
+    values = 100 * shares.fillna(0).to_numpy()
+    edges = np.append(starts, starts[-1] + block)  # each block's shares drawn over its whole width
+    fig, ax = plt.subplots(figsize=(9, 5))
+    ax.stackplot(edges, np.vstack([values, values[-1:]]).T, labels=list(shares.columns), step="post",
+                 colors=plt.get_cmap("tab10").colors[:shares.shape[1]])
+    ax.set_xlabel("episode")
+    ax.set_ylabel(f"share of the failures in each {block} episodes, %")
+    ax.set_ylim(0, 100)
+    ax.set_xlim(edges[0], edges[-1])
+    ax.legend(loc="upper left", fontsize="small", title=cause_key)
+    ax.set_title(title)
+    return _write(fig, png_path)
+
+
+def _has_values(csv_path: Path, column: str) -> bool:
+    """``csv_path`` exists and its ``column`` holds a value in some row."""
+    if not csv_path.exists():
+        return False
+    head = pd.read_csv(csv_path, nrows=0).columns
+    return column in head and pd.read_csv(csv_path, usecols=[column])[column].notna().any()
 
 
 def full_episodes(df: pd.DataFrame, partial_key: str | None) -> pd.DataFrame:

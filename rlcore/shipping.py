@@ -51,7 +51,7 @@ def run_evaluation(exp, policy, episodes: int, seed_base: int | None) -> tuple[d
     seeds = f"{seed_base}..{seed_base + episodes - 1}"
     success_key, progress_key = exp.success_key, exp.progress_key
     if success_key:
-        from rlcore.evaluation import evaluate_success, summarize_success
+        from rlcore.evaluation import count_causes, evaluate_success, summarize_success
 
         records = evaluate_success(policy.make_env, policy.sample, episodes, seed_base, success_key,
                                    progress_key, info_keys=exp.info_keys)
@@ -63,6 +63,9 @@ def run_evaluation(exp, policy, episodes: int, seed_base: int | None) -> tuple[d
         if progress_key:
             line += (f"; {progress_key} mean {summary[f'mean_{progress_key}']:.0f}, "
                      f"max {summary[f'max_{progress_key}']:.0f}")
+        if exp.cause_key and (causes := count_causes(records, exp.cause_key, exp.cause_name)):
+            summary["causes"] = dict(causes)
+            line += f"; {exp.cause_key}: " + ", ".join(f"{name} {count}" for name, count in causes)
         return summary, line + f" (seeds {seeds}, actions sampled from pi)"
     from rlcore.evaluation import play_greedy
 

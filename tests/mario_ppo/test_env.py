@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from mario_ppo.env import FRAME_SIZE, ClassicReward, SkipAndHistory, SkipAndStack, classic_reward, gray_84, make_env
+from mario_ppo.deaths import KilledBy
 from mario_ppo.episode_ends import DeadEnds, StallLimit
 from rlcore.errors import UserError
 from tests.mario_ppo.scripted import ScriptedInfos
@@ -172,10 +173,10 @@ def test_reward_and_stall_options_reach_the_env_from_the_config():
         assert isinstance(env, StallLimit) and env.steps == 7
         assert env.get_wrapper_attr("score_reward") == 0.025
         assert isinstance(env.env, DeadEnds) and env.env.rule is not None
-        assert isinstance(env.env.env, SkipAndHistory)
+        assert isinstance(env.env.env, KilledBy) and isinstance(env.env.env.env, SkipAndHistory)
     finally:
         env.close()
     plain = EXPERIMENT.env_factory(EXPERIMENT.preset("ppo", "default"))()
     assert not isinstance(plain, StallLimit) and plain.get_wrapper_attr("score_reward") == 0.0
-    assert type(plain) is SkipAndStack
+    assert type(plain) is KilledBy and type(plain.env) is SkipAndStack
     plain.close()

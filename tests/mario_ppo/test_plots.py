@@ -77,3 +77,33 @@ def test_a_plot_title_names_the_mario_level():
     assert plot_title(get_experiment("mario_ppo"), about) == "mario_ppo ppo 2-1 (default preset, seed 0)"
     about = {"algo": "dqn", "preset": "article", "seed": 3, "config": {}}
     assert plot_title(get_experiment("lunar_lander"), about) == "lunar_lander dqn (article preset, seed 3)"
+
+
+def test_a_deaths_plot_once_killed_by_is_logged(capsys, tmp_path):
+    """A run resumed by code that logs `killed_by` gets the Deaths plot, from its first logged cause."""
+    from rlcore.checkpoint import save_checkpoint
+
+    rows = ["episode,total_points,av_latest_points,target_ave_scores,x_pos,success,success_share,killed_by"]
+    causes = [""] * 30 + ["10", "", "-1", "6", "10"] * 6  # logged from episode 31 on; "" is not a death
+    rows += [f"{i},10,0,0,{300 + i},{int(c == '')},0,{c}" for i, c in enumerate(causes, start=1)]
+    (tmp_path / "metrics.csv").write_text("\n".join(rows) + "\n")
+    save_checkpoint(tmp_path / "checkpoint.npz", {}, {}, {"experiment": "mario_ppo", "algo": "ppo",
+                                                          "preset": "default", "seed": 0,
+                                                          "config": {"window": 20}})
+    code, out, err = run(capsys, "plot", str(tmp_path))
+    assert code == 0, err
+    assert Path(out.splitlines()[-1].split()[-1]).name == "mario_ppo_Deaths_ppo.png"
+
+
+def test_cause_shares_are_the_shares_of_each_blocks_failures():
+    import pandas as pd
+
+    from rlcore.plotting import cause_shares
+
+    causes = pd.Series([None, "fish", "pit", "fish", None, "goomba", "fish", "fish", "pit", None, None, None])
+    shares = cause_shares(causes, block=3, most=2)
+    assert list(shares.columns) == ["fish", "pit", "other"]
+    np.testing.assert_allclose(shares.iloc[0], [0.5, 0.5, 0.0])      # fish, pit
+    np.testing.assert_allclose(shares.iloc[1], [0.5, 0.0, 0.5])      # fish, goomba (other)
+    np.testing.assert_allclose(shares.iloc[2], [2 / 3, 1 / 3, 0.0])  # fish, fish, pit
+    assert shares.iloc[3].isna().all()                               # no failure in the last block

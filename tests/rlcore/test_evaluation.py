@@ -68,3 +68,29 @@ def test_the_summary_counts_the_episodes_that_lasted_to_the_time_limit():
     assert summary["mean_x"] == pytest.approx(2.0)
     assert [r["seed"] for r in summary["per_episode"]] == [10, 11, 12, 13]
     assert "2/4 lasted to the time limit" in line and "x at the end: mean 2.00, max 3.00" in line
+
+
+class FallWithCause(FallOrWalk):
+    """FallOrWalk with a success (the time limit reached) and, at a fall, its cause: the seed % 3."""
+
+    def step(self, action):
+        obs, reward, fell, limit, info = super().step(action)
+        if fell:
+            info["cause"] = float(self.fall_at % 3)
+        return obs, reward, fell, limit, {**info, "won": limit}
+
+
+def test_a_success_evaluation_counts_its_failures_by_cause():
+    class Policy:
+        make_env = staticmethod(FallWithCause)
+
+        def sample(self, obs, rng):
+            return ALWAYS_ZERO(obs)
+
+    exp = Experiment(name="cause", description="", make_env=lambda **_: FallWithCause(), algos={},
+                     solved_score=None, success_key="won", info_keys=("cause",), cause_key="cause",
+                     cause_name=lambda code: ["rock", "hole", "bird"][int(code)])
+    # seeds 10-17: the odd ones win; 10, 12, 14, 16 fall after 1, 3, 5, 2 steps: causes 1, 0, 2, 2
+    summary, line = run_evaluation(exp, Policy(), episodes=8, seed_base=10)
+    assert summary["success_share"] == 0.5 and summary["causes"] == {"bird": 2, "hole": 1, "rock": 1}
+    assert "won in 4/8 episodes" in line and "; cause: bird 2, hole 1, rock 1 (seeds 10..17" in line
