@@ -8,17 +8,22 @@ import pytest
 from tests.test_cli import run
 
 
-def test_plot_of_an_unfinished_mario_run(capsys, tmp_path):
-    """A run with only a checkpoint and its metrics (training still going) gets its plots."""
+def write_run(run_dir: Path, rows: list[str]) -> None:
+    """A Mario run folder as a training leaves it: metrics.csv (``rows``) and a checkpoint."""
     from rlcore.checkpoint import save_checkpoint
 
+    (run_dir / "metrics.csv").write_text("\n".join(rows) + "\n")
+    save_checkpoint(run_dir / "checkpoint.npz", {}, {}, {"experiment": "mario_ppo", "algo": "ppo",
+                                                         "preset": "default", "seed": 0,
+                                                         "config": {"window": 20}})
+
+
+def test_plot_of_an_unfinished_mario_run(capsys, tmp_path):
+    """A run with only a checkpoint and its metrics (training still going) gets its plots."""
     rows = ["episode,total_points,av_latest_points,target_ave_scores,x_pos,success,success_share"]
     rows += [f"{i},{i % 7 * 10},{30 + i / 10},0,{300 + 40 * i},{int(i == 20)},{0.05 * (i >= 20)}"
              for i in range(1, 31)]
-    (tmp_path / "metrics.csv").write_text("\n".join(rows) + "\n")
-    save_checkpoint(tmp_path / "checkpoint.npz", {}, {}, {"experiment": "mario_ppo", "algo": "ppo",
-                                                          "preset": "default", "seed": 0,
-                                                          "config": {"window": 20}})
+    write_run(tmp_path, rows)
     code, out, err = run(capsys, "plot", str(tmp_path))
     assert code == 0, err
     written = [line.split()[-1] for line in out.splitlines()]
@@ -30,14 +35,9 @@ def test_plot_of_an_unfinished_mario_run(capsys, tmp_path):
 def test_mario_plots_leave_out_restarted_episodes(capsys, tmp_path, monkeypatch):
     """Restarts start at x 2,900: their ends must not show in the endings map or the curves."""
     import rlcore.plotting as plotting
-    from rlcore.checkpoint import save_checkpoint
-
     rows = ["episode,total_points,av_latest_points,target_ave_scores,x_pos,success,success_share,restarted"]
     rows += [f"{i},{5 if i % 2 else 300},0,0,{3000 if i % 2 else 300 + i},0,0,{i % 2}" for i in range(1, 41)]
-    (tmp_path / "metrics.csv").write_text("\n".join(rows) + "\n")
-    save_checkpoint(tmp_path / "checkpoint.npz", {}, {}, {"experiment": "mario_ppo", "algo": "ppo",
-                                                          "preset": "default", "seed": 0,
-                                                          "config": {"window": 20}})
+    write_run(tmp_path, rows)
     ended_at, kept = [], []  # what the endings map and each plot were given
     ending_shares, full_episodes = plotting.ending_shares, plotting.full_episodes
 
@@ -81,15 +81,10 @@ def test_a_plot_title_names_the_mario_level():
 
 def test_a_deaths_plot_once_killed_by_is_logged(capsys, tmp_path):
     """A run resumed by code that logs `killed_by` gets the Deaths plot, from its first logged cause."""
-    from rlcore.checkpoint import save_checkpoint
-
     rows = ["episode,total_points,av_latest_points,target_ave_scores,x_pos,success,success_share,killed_by"]
     causes = [""] * 30 + ["10", "", "-1", "6", "10"] * 6  # logged from episode 31 on; "" is not a death
     rows += [f"{i},10,0,0,{300 + i},{int(c == '')},0,{c}" for i, c in enumerate(causes, start=1)]
-    (tmp_path / "metrics.csv").write_text("\n".join(rows) + "\n")
-    save_checkpoint(tmp_path / "checkpoint.npz", {}, {}, {"experiment": "mario_ppo", "algo": "ppo",
-                                                          "preset": "default", "seed": 0,
-                                                          "config": {"window": 20}})
+    write_run(tmp_path, rows)
     code, out, err = run(capsys, "plot", str(tmp_path))
     assert code == 0, err
     assert Path(out.splitlines()[-1].split()[-1]).name == "mario_ppo_Deaths_ppo.png"
