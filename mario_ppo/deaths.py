@@ -87,4 +87,3 @@ class KilledBy(gym.Wrapper):
             if is_game_death(ram):
                 info["killed_by"] = killed_by(ram)
         return obs, reward, terminated, truncated, info
-
