@@ -66,8 +66,6 @@ def is_game_death(ram: np.ndarray) -> bool:
 
 def cause_name(code: float) -> str:
     """A ``killed_by`` number in words."""
-    if code != code:  # NaN
-        return "not a death"
     code = int(code)
     return {FELL: "fell", TIME_UP: "time up", NONE_NEAR: "no enemy near"}.get(
         code, ENEMY_NAMES.get(code, f"enemy 0x{code:02X}"))

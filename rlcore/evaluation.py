@@ -1,6 +1,8 @@
 """Greedy evaluation on seeds that training never uses."""
 from __future__ import annotations
 
+from collections import Counter
+
 import numpy as np
 from tqdm import tqdm
 
@@ -115,11 +117,8 @@ def summarize_success(records: list[dict], progress_key: str | None = None) -> d
 
 
 def count_causes(records: list[dict], cause_key: str, cause_name) -> list[tuple[str, int]]:
-    """(cause in words, episodes) over the records that hold ``cause_key``, most first; numbers that
-    ``cause_name`` puts in the same words (Mario: the five Firebar ids) count together."""
-    counts: dict[str, int] = {}
-    for record in records:
-        if record.get(cause_key, float("nan")) == record.get(cause_key):  # present and not NaN
-            name = cause_name(record[cause_key])
-            counts[name] = counts.get(name, 0) + 1
-    return sorted(counts.items(), key=lambda item: -item[1])
+    """(cause in words, episodes) over the records that hold ``cause_key``, most first (ties in the
+    order met); numbers that ``cause_name`` puts in the same words (Mario: the five Firebar ids)
+    count together."""
+    names = Counter(cause_name(r[cause_key]) for r in records if not np.isnan(r.get(cause_key, np.nan)))
+    return names.most_common()

@@ -58,7 +58,7 @@ class Experiment:
     # (Mario: killed_by, a fall, the clock or an enemy; mario_ppo.deaths.cause_name): the evaluation
     # line counts its failures by cause, and a Deaths plot shows the causes' shares over training
     cause_key: str | None = None
-    cause_name: Callable[[float], str] | None = None
+    cause_name: Callable[[float], str] = str
     # config fields that make_env takes in training only (Mario: restart_x, ...): the
     # trainer's env pool gets them; evaluations, videos and saved models build the env without them
     train_env_fields: tuple[str, ...] = ()

@@ -160,7 +160,7 @@ def plot_endings(csv_path: str | Path, png_path: str | Path, title: str, progres
 def cause_shares(causes: pd.Series, block: int, most: int = 6) -> pd.DataFrame:
     """What ended the failures, over training: the share of each cause (words) among the failures of
     each block of ``block`` episodes (a row per block, the ``most`` commonest causes, then "other";
-    each row sums to 1, a block without failures is NaN). ``causes`` holds None where an episode did
+    each row sums to 1, a block without failures is NaN). ``causes`` is NaN where an episode did
     not fail (or before the cause was logged)."""
     blocks = pd.Series(np.arange(len(causes)) // block, index=causes.index)
     named = causes.dropna()
@@ -179,8 +179,7 @@ def plot_causes(csv_path: str | Path, png_path: str | Path, title: str, cause_ke
     restarted episodes included."""
     df = _table(csv_path, "episode", cause_key)
     df = df.loc[df[cause_key].first_valid_index():]  # a run resumed by newer code logs it from there on
-    codes = df[cause_key]
-    causes = codes.map(lambda code: cause_name(code) if code == code else None)
+    causes = df[cause_key].map(cause_name, na_action="ignore")
     block = max(20, int(np.ceil(len(df) / blocks)))  # fewer blocks while a few hundred are logged
     shares = cause_shares(causes, block)
     starts = df["episode"].to_numpy()[::block][:len(shares)]
@@ -202,8 +201,8 @@ def _has_values(csv_path: Path, column: str) -> bool:
     """``csv_path`` exists and its ``column`` holds a value in some row."""
     if not csv_path.exists():
         return False
-    head = pd.read_csv(csv_path, nrows=0).columns
-    return column in head and pd.read_csv(csv_path, usecols=[column])[column].notna().any()
+    df = pd.read_csv(csv_path, usecols=lambda name: name == column)
+    return column in df and df[column].notna().any()
 
 
 def full_episodes(df: pd.DataFrame, partial_key: str | None) -> pd.DataFrame:

@@ -3,8 +3,8 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-from mario_ppo.env import FRAME_SIZE, ClassicReward, SkipAndHistory, SkipAndStack, classic_reward, gray_84, make_env
 from mario_ppo.deaths import KilledBy
+from mario_ppo.env import FRAME_SIZE, ClassicReward, SkipAndHistory, SkipAndStack, classic_reward, gray_84, make_env
 from mario_ppo.episode_ends import DeadEnds, StallLimit
 from rlcore.errors import UserError
 from tests.mario_ppo.scripted import ScriptedInfos
