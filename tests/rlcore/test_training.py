@@ -46,7 +46,8 @@ def test_ppo_learns_the_picture_task_and_stops_on_the_success_share(tmp_path):
     assert rollouts[0].startswith("rollout,env_steps,episodes_ended,successes,max_score,loss,policy_loss")
     timing = pd.read_csv(tmp_path / "ppo" / "rollouts.csv")[["collect_seconds", "update_seconds"]]
     assert (timing.collect_seconds > 0).all() and (timing.update_seconds >= 0).all()  # a toy update: ~ms
-    assert timing.update_seconds.sum() > 0 and timing.to_numpy().sum() <= meta["wall_seconds"]
+    rounding = 0.05 + 0.0005 * timing.size  # meta keeps 0.1 s, the table 1 ms per cell
+    assert timing.update_seconds.sum() > 0 and timing.to_numpy().sum() <= meta["wall_seconds"] + rounding
     metrics = (model_dir / "metrics.csv").read_text().splitlines()
     assert "success_share" in metrics[0] and len(metrics) == meta["episodes"] + 1
     assert (model_dir / "toy_image_Progress_ppo.png").stat().st_size > 1000  # progress + success share
