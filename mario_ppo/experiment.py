@@ -12,6 +12,7 @@ from mario_ppo.deaths import cause_name
 from mario_ppo.env import ACTION_SETS, FRAME_STACKS, make_env
 from mario_ppo.episode_ends import StallLimit
 from mario_ppo.levels import STAGE, WORLD
+from mario_ppo.restarts import WEIGHTS
 from rlcore.allowed import OFF_OR_COUNT, Allowed, choices, require
 from rlcore.configs import PPOConfig
 from rlcore.experiment import AlgoSpec, Experiment
@@ -48,8 +49,13 @@ class MarioPPOConfig(PPOConfig):
                 "passed, the point drawn uniformly for each restarted episode, for a level whose hard "
                 "places are not known (0 = off)", "allowed": OFF_OR_COUNT})
     restart_share: float = field(default=0.5, metadata={
-        "help": "with --restart-x or --restart-every: the share of training episodes that start there; they are left out "
-                "of the flag share the stop rule reads", "allowed": Allowed(low=0, high=1)})
+        "help": "with --restart-x or --restart-every: the share of training episodes that start there; "
+                "they are left out of the flag share the stop rule reads", "allowed": Allowed(low=0, high=1)})
+    restart_weights: str = field(default="uniform", metadata={
+        "help": "with --restart-every: how a restarted episode's point is drawn: uniform, or deaths (in "
+                "proportion to 1 + the env's recent failed episodes that ended between that point and "
+                "the next, so the places where the policy dies get the most tries)",
+        "allowed": choices(*WEIGHTS)})
 
     def __post_init__(self):
         super().__post_init__()
@@ -110,7 +116,8 @@ EXPERIMENT = Experiment(
                                                                    "levels": LEVELS})},
     video_fps=60,
     env_fields=("world", "stage", "actions", "score_reward", "stall_steps", "stall_outcome",
-                "frames", "dead_ends"), train_env_fields=("restart_x", "restart_every", "restart_share"),
+                "frames", "dead_ends"),
+    train_env_fields=("restart_x", "restart_every", "restart_share", "restart_weights"),
     success_key="flag_get", progress_key="x_pos", partial_key="restarted", env_memory="restart_routes",
     info_keys=("stalled", "start_x", "killed_by"), cause_key="killed_by", cause_name=cause_name,
     eval_episodes=10, ship_by=("world", "stage"), default_model="1-1", score_label="return (shaped, /10)",

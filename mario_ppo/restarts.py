@@ -12,6 +12,14 @@ Two ways to say where: one x (``restart_x``, a known hard place), or every multi
 at one of the kept points, drawn uniformly, so the far parts of the level get as many tries as the
 near ones.
 
+Where the policy dies most, restarts can go more often (``weights="deaths"``): point k is drawn with
+probability proportional to 1 + the failed episodes, among this env's last :data:`DEATHS_KEPT`, that
+ended past point k and before point k + 1 (:func:`death_weights`). On 2-2 at rollouts 1000-1140, 55 %
+of the failures came between x 1,450 and 2,175 and 2 % past x 2,900, where uniform restarts sent a
+quarter of them (95 % of which reached the flag). The failures are counted by the wrapper, so an
+episode cut short above it (a stall, a dead end) counts where it stopped; they are not checkpointed,
+so a resumed run draws uniformly until its envs have failed again.
+
 Evaluation never uses it: both are training-only settings (``Experiment.train_env_fields``), so
 every evaluation and video starts at the level's start. Restarted episodes are marked
 (``info["restarted"]``) and left out of the flag share that the stop rule reads; ``info["start_x"]``
@@ -26,8 +34,23 @@ TensorFlow-free: env-pool worker processes import this module.
 """
 from __future__ import annotations
 
+from collections import Counter, deque
+from collections.abc import Iterable
+
 import gymnasium as gym
 import numpy as np
+
+WEIGHTS = ("uniform", "deaths")
+DEATHS_KEPT = 100  # failed episodes per env that weigh the points: ~30 rollouts of 8 envs on 2-2
+
+
+def death_weights(points: list[int], failures: Iterable[int]) -> np.ndarray:
+    """The chance of each kept point (sorted numbers) to be a restart's start: 1 + the number of
+    ``failures`` (the point numbers at which failed episodes ended) at that point, normalized. The 1
+    keeps every point in play; failures before the first kept point weigh nothing."""
+    counts = Counter(failures)
+    weights = np.array([1.0 + counts[point] for point in points])
+    return weights / weights.sum()
 
 
 class Restarts(gym.Wrapper):
@@ -40,14 +63,18 @@ class Restarts(gym.Wrapper):
     points follow the current policy). From then on, each reset loads one kept state with probability
     ``share``, the point drawn uniformly; both draws come from the env's seeded RNG. The kept states
     live in this env; ``restart_routes`` gets and sets them as routes (a resumed run's pool sets what
-    the checkpoint kept).
+    the checkpoint kept). With ``weights="deaths"`` the point is drawn by :func:`death_weights`.
     """
 
-    def __init__(self, env: gym.Env, share: float, x: int = 0, every: int = 0):
+    def __init__(self, env: gym.Env, share: float, x: int = 0, every: int = 0, weights: str = "uniform"):
         super().__init__(env)
         if bool(x) == bool(every):
             raise ValueError("give one of x (a single restart point) and every (a spacing)")
-        self.x, self.every, self.share = x, every, share
+        if weights not in WEIGHTS:
+            raise ValueError(f"unknown restart weights {weights!r}; choose one of {', '.join(WEIGHTS)}")
+        self.x, self.every, self.share, self.weights = x, every, share, weights
+        self.failures: deque[int] = deque(maxlen=DEATHS_KEPT)  # the point each failed episode ended at
+        self._last: dict | None = None  # the info of this episode's last step (None: no step yet)
         self._snapshots: dict[int, tuple[object, bytes]] = {}  # point number -> (emulator state, route)
         self._restarted = False
         self._passed = 0
@@ -61,12 +88,19 @@ class Restarts(gym.Wrapper):
         return int(x_pos >= self.x)
 
     def reset(self, *, seed=None, options=None):
+        if self._last is not None and not self._last.get("flag_get"):
+            self.failures.append(self.point(self._last["x_pos"]))
+        self._last = None
         obs, info = self.env.reset(seed=seed, options=options)
         self._restarted = bool(self._snapshots) and self.np_random.random() < self.share
         self._route = bytearray()
         if self._restarted:
             points = sorted(self._snapshots)
-            snapshot, route = self._snapshots[points[self.np_random.integers(len(points))]]
+            if self.weights == "deaths":
+                pick = self.np_random.choice(len(points), p=death_weights(points, self.failures))
+            else:
+                pick = self.np_random.integers(len(points))
+            snapshot, route = self._snapshots[points[pick]]
             base = self.env.unwrapped
             base.load_state(snapshot)
             base._did_reset()  # the env's own "last" counters (time, x, score) from the loaded state
@@ -80,6 +114,7 @@ class Restarts(gym.Wrapper):
     def step(self, action):
         obs, reward, terminated, truncated, info = self.env.step(action)
         self._route.append(int(action))
+        self._last = info
         reached = self.point(info["x_pos"])
         if reached > self._passed:
             if not (terminated or truncated or info.get("is_dying")):

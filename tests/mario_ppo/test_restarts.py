@@ -62,7 +62,8 @@ def test_the_share_of_restarts_follows_the_seeded_rng():
 
 
 def test_restarts_reach_the_training_envs_only():
-    cfg = dataclasses.replace(EXPERIMENT.preset("ppo", "default"), restart_x=X, restart_share=0.25)
+    cfg = dataclasses.replace(EXPERIMENT.preset("ppo", "default"), restart_every=EVERY, restart_share=0.25,
+                              restart_weights="deaths")
 
     def wrappers(env):
         found = []
@@ -76,6 +77,7 @@ def test_restarts_reach_the_training_envs_only():
     try:
         kept = [w for w in wrappers(training) if w is Restarts]
         assert kept and training.get_wrapper_attr("share") == 0.25
+        assert training.get_wrapper_attr("weights") == "deaths"
         assert Restarts not in wrappers(evaluation)
         assert "restarted" not in evaluation.reset(seed=0)[1]
     finally:
@@ -159,3 +161,64 @@ def test_a_pool_of_processes_hands_the_routes_out_and_back():
         checkpoints.give_env_memory(resumed, EXPERIMENT.env_memory, arrays)
         _, infos = resumed.reset(seed=[5, 6])
         assert infos["restarted"].all() and (infos["x_pos"] >= EVERY).all()
+
+
+def test_death_weights_add_one_to_the_failures_at_each_kept_point():
+    from mario_ppo.restarts import death_weights
+
+    # failures at 0 (before the first point) and at 5 (no state kept there) weigh nothing
+    got = death_weights([1, 2, 3, 4], [2, 2, 2, 3, 0, 5])
+    np.testing.assert_allclose(got, np.array([1, 4, 2, 1]) / 8)
+    np.testing.assert_allclose(death_weights([3, 7], []), [0.5, 0.5])
+
+
+def _restarts(env):
+    while not isinstance(env, Restarts):
+        env = env.env
+    return env
+
+
+def test_an_episode_that_dies_counts_as_a_failure_at_its_point():
+    env = make_env(restart_every=EVERY, restart_share=1.0, restart_weights="deaths")
+    try:
+        env.reset(seed=0)
+        assert list(_restarts(env).failures) == []
+        while True:  # running right on 1-1 meets the first Goomba (test_deaths)
+            _, _, terminated, truncated, info = env.step(RIGHT)
+            if terminated or truncated:
+                break
+        env.reset(seed=1)
+        assert list(_restarts(env).failures) == [info["x_pos"] // EVERY] and info["x_pos"] >= EVERY
+        env.reset(seed=2)  # no step since the last reset: nothing to count
+        assert len(_restarts(env).failures) == 1
+    finally:
+        env.close()
+
+
+def test_restarts_weighted_by_deaths_go_where_the_failures_were():
+    def starts(weights, failures):
+        env = make_env(restart_every=EVERY, restart_share=1.0, restart_weights=weights)
+        try:
+            env.reset(seed=0)
+            _run_right_past(env, 2 * EVERY)  # points 1 and 2 kept
+            _restarts(env).failures.extend(failures)
+            return [env.reset(seed=s)[1]["x_pos"] // EVERY for s in range(1, 31)]
+        finally:
+            env.close()
+
+    weighted = starts("deaths", [2] * 40)  # point 2 drawn with probability 41/42
+    assert weighted.count(2) >= 27
+    uniform = starts("uniform", [2] * 40)
+    assert 6 <= uniform.count(2) <= 24
+    assert starts("deaths", [2] * 40) == weighted  # the seeded RNG draws the same points
+
+
+def test_unknown_restart_weights_are_refused():
+    import pytest
+
+    from rlcore.errors import UserError
+
+    with pytest.raises(UserError, match="restart.weights"):
+        dataclasses.replace(EXPERIMENT.preset("ppo", "default"), restart_weights="nearest")
+    with pytest.raises(ValueError, match="unknown restart weights"):
+        Restarts(make_env().unwrapped, 0.5, every=EVERY, weights="nearest")
