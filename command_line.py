@@ -142,6 +142,16 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
                                       "share, a map of where episodes ended, and what killed Mario.")
     plot.add_argument("run_dir", help="a run folder, e.g. runs/mario_ppo__ppo__0__<time>")
     plot.add_argument("--out", default=None, help="folder for the PNGs (default RUN_DIR/plots)")
+
+    status = sub.add_parser("status", help="where a run stands, in a few lines (running, interrupted or "
+                                           "finished)",
+                            description="Print where a run stands from its CSV tables: per block of "
+                                        "episodes that started where evaluations start, the success "
+                                        "share, mean progress and mean return, the restarted episodes "
+                                        "beside them, and what ended the failures.")
+    status.add_argument("run_dir", help="a run folder, e.g. long_runs/mario_ppo/2-2")
+    status.add_argument("--block", type=COUNT, default=200, help="episodes per block (default 200)")
+    status.add_argument("--blocks", type=COUNT, default=6, help="how many of the newest blocks (default 6)")
     return parser
 
 

@@ -184,25 +184,43 @@ def cmd_render(args) -> int:
     return 0
 
 
-def cmd_plot(args) -> int:
+def _run_folder(run_dir: Path) -> dict:
+    """What the run in ``run_dir`` trained: its model's meta.json once finished (or a shipped model
+    folder's own), else its checkpoint's state; a folder with none, or without metrics.csv, is a
+    clear error."""
     from rlcore.checkpoint import read_checkpoint_state
-    from rlcore.experiment import get_experiment
-    from rlcore.plotting import plot_run
     from rlcore.trainers.spec import CHECKPOINT_FILE
 
-    run_dir = Path(args.run_dir)
     if not (run_dir / "metrics.csv").is_file():
         raise UserError(f"no metrics.csv in {run_dir}; give a run folder such as runs/<name>")
-    if (run_dir / "model" / "meta.json").is_file():
-        about = json.loads((run_dir / "model" / "meta.json").read_text())
-    elif (run_dir / CHECKPOINT_FILE).is_file():
-        about = read_checkpoint_state(run_dir / CHECKPOINT_FILE)
-    else:
-        raise UserError(f"{run_dir} has neither a checkpoint nor a model/meta.json to say what it trained")
+    for meta in (run_dir / "model" / "meta.json", run_dir / "meta.json"):
+        if meta.is_file():
+            return json.loads(meta.read_text())
+    if (run_dir / CHECKPOINT_FILE).is_file():
+        return read_checkpoint_state(run_dir / CHECKPOINT_FILE)
+    raise UserError(f"{run_dir} has neither a checkpoint nor a model/meta.json to say what it trained")
+
+
+def cmd_plot(args) -> int:
+    from rlcore.experiment import get_experiment
+    from rlcore.plotting import plot_run
+
+    run_dir = Path(args.run_dir)
+    about = _run_folder(run_dir)
     out_dir = Path(args.out) if args.out else run_dir / "plots"
     writable_folder(out_dir, "--out")
     for path in plot_run(run_dir, out_dir, get_experiment(about["experiment"]), about):
         print(f"plot:    {path}")
+    return 0
+
+
+def cmd_status(args) -> int:
+    from rlcore.experiment import get_experiment
+    from rlcore.status import run_status
+
+    run_dir = Path(args.run_dir)
+    about = _run_folder(run_dir)
+    print("\n".join(run_status(run_dir, get_experiment(about["experiment"]), about, args.block, args.blocks)))
     return 0
 
 
@@ -263,7 +281,7 @@ def cmd_report(args) -> int:
 
 
 COMMANDS = {"list": cmd_list, "train": cmd_train, "evaluate": cmd_evaluate, "render": cmd_render,
-            "plot": cmd_plot, "sweep": cmd_sweep, "report": cmd_report}
+            "plot": cmd_plot, "status": cmd_status, "sweep": cmd_sweep, "report": cmd_report}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -280,6 +298,9 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("\naborted (no checkpoint written by this interrupt)", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # the reader left (`main.py status RUN | head -1`): nothing to say to it
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # so exit's flush is quiet
+        return 1
     except Exception as exc:
         from rlcore.trainers.stopping import Interrupted
         if isinstance(exc, Interrupted):

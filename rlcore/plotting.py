@@ -62,7 +62,7 @@ def plot_episode_scores(csv_path: str | Path, png_path: str | Path, title: str,
     """Score per episode, its moving average and the solved line, as in article 000's figure.
     Episodes marked by ``partial_key`` (Mario's restarts) are left out, and the average is taken
     over the others."""
-    df = _table(csv_path, "episode", "total_points", "av_latest_points")
+    df = read_table(csv_path, "episode", "total_points", "av_latest_points")
     full = full_episodes(df, partial_key)
     if len(full) < len(df):  # the logged average counted every episode: take it over these only
         df = full.assign(av_latest_points=full["total_points"].rolling(100, min_periods=1).mean())
@@ -80,7 +80,7 @@ def plot_episode_scores(csv_path: str | Path, png_path: str | Path, title: str,
 def plot_evaluations(csv_path: str | Path, png_path: str | Path, title: str,
                      solved_score: float | None = None, score_label: str = "return") -> Path:
     """Periodic greedy evaluation: mean +- std against env steps (article 002's test-reward curve)."""
-    df = _table(csv_path, "env_steps", "eval_mean", "eval_std")
+    df = read_table(csv_path, "env_steps", "eval_mean", "eval_std")
     fig, ax = plt.subplots(figsize=(9, 5))
     ax.plot(df["env_steps"], df["eval_mean"], color="tab:blue", linewidth=2, label="Evaluation mean")
     ax.fill_between(df["env_steps"], df["eval_mean"] - df["eval_std"], df["eval_mean"] + df["eval_std"],
@@ -97,7 +97,7 @@ def plot_progress(csv_path: str | Path, png_path: str | Path, title: str, progre
     """Episodes with a goal (Mario's flag): how far each got (``progress_key``, with its moving
     average) and, on the right axis, the share of the last ``window`` episodes that succeeded.
     Episodes marked by ``partial_key`` (Mario's restarts, which start further in) are left out."""
-    df = full_episodes(_table(csv_path, "episode", progress_key), partial_key)
+    df = full_episodes(read_table(csv_path, "episode", progress_key), partial_key)
     fig, ax = plt.subplots(figsize=(9, 5))
     ax.plot(df["episode"], df[progress_key], color="tab:blue", linewidth=1, alpha=0.5, label=progress_key)
     ax.plot(df["episode"], df[progress_key].rolling(window, min_periods=1).mean(), color="tab:orange",
@@ -136,7 +136,7 @@ def plot_endings(csv_path: str | Path, png_path: str | Path, title: str, progres
     """A map of where episodes ended (``progress_key``, e.g. Mario's x) over training: the dark rows
     are where the agent keeps dying or stalling. Episodes with a ``stalled`` mark add its share.
     Episodes marked by ``partial_key`` (Mario's restarts, which start further in) are left out."""
-    df = full_episodes(_table(csv_path, "episode", progress_key), partial_key)
+    df = full_episodes(read_table(csv_path, "episode", progress_key), partial_key)
     block = max(1, int(np.ceil(len(df) / blocks)))
     starts, edges, shares = ending_shares(df[progress_key].to_numpy(), block)
     fig, ax = plt.subplots(figsize=(9, 5))
@@ -177,7 +177,7 @@ def plot_causes(csv_path: str | Path, png_path: str | Path, title: str, cause_ke
     """What ends the failed episodes (``cause_key``, e.g. Mario's killed_by) over training, as
     shares of the failures of each block of episodes, from the first episode that logged a cause;
     restarted episodes included."""
-    df = _table(csv_path, "episode", cause_key)
+    df = read_table(csv_path, "episode", cause_key)
     df = df.loc[df[cause_key].first_valid_index():]  # a run resumed by newer code logs it from there on
     causes = df[cause_key].map(cause_name, na_action="ignore")
     block = max(20, int(np.ceil(len(df) / blocks)))  # fewer blocks while a few hundred are logged
@@ -210,7 +210,7 @@ def full_episodes(df: pd.DataFrame, partial_key: str | None) -> pd.DataFrame:
     return df[df[partial_key] != 1] if partial_key and partial_key in df else df
 
 
-def _table(csv_path: str | Path, *columns: str) -> pd.DataFrame:
+def read_table(csv_path: str | Path, *columns: str) -> pd.DataFrame:
     """The CSV table at ``csv_path``, checked to hold ``columns``; a damaged one is a clear error."""
     try:
         df = pd.read_csv(csv_path)

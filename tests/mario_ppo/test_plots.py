@@ -15,7 +15,9 @@ def write_run(run_dir: Path, rows: list[str]) -> None:
     (run_dir / "metrics.csv").write_text("\n".join(rows) + "\n")
     save_checkpoint(run_dir / "checkpoint.npz", {}, {}, {"experiment": "mario_ppo", "algo": "ppo",
                                                          "preset": "default", "seed": 0,
-                                                         "config": {"window": 20}})
+                                                         "config": {"window": 20}, "env_steps": 4096 * 7,
+                                                         "returns": [0.0] * (len(rows) - 1),
+                                                         "wall_seconds": 5400.0})
 
 
 def test_plot_of_an_unfinished_mario_run(capsys, tmp_path):

@@ -1,0 +1,80 @@
+"""``main.py status RUN_DIR``: where a run stands, in a few lines, from its CSV tables.
+
+For a run that lasts many sessions (a Mario level): per block of episodes that started where
+evaluations start, the success share, the mean progress and the mean return; the episodes that started
+elsewhere (Mario's restarts) beside them; and what ended the failures. It reads the same tables as
+``main.py plot`` and works on a run that is training, interrupted or finished. TensorFlow-free.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import pandas as pd
+
+from rlcore.plotting import full_episodes, read_table
+
+
+def run_status(run_dir: str | Path, experiment, about: dict, block: int = 200, blocks: int = 6) -> list[str]:
+    """The lines ``main.py status`` prints: a headline from ``about`` (a checkpoint's state or a
+    model's meta.json), then one line per block of ``block`` full episodes, the last ``blocks`` of
+    them, then the commonest causes of failure over those blocks' span (all episodes)."""
+    df = read_table(Path(run_dir) / "metrics.csv", "episode", "env_steps", "total_points")
+    lines = [headline(experiment, about)]
+    full = full_episodes(df, experiment.partial_key)
+    recent = full.tail(block * blocks)
+    if recent.empty:
+        return lines + ["no episode from the start logged yet"]
+    first = len(recent) % block  # whole blocks end at the newest episode; a short first one
+    starts = ([0] if first else []) + list(range(first, len(recent), block))
+    span = df[df["episode"] >= recent["episode"].iloc[0]]
+    for begin, end in zip(starts, starts[1:] + [len(recent)]):
+        part = recent.iloc[begin:end]
+        lines.append(block_line(experiment, part, _partial_between(df, experiment, part)))
+    causes = cause_line(experiment, span)
+    return lines + ([causes] if causes else [])
+
+
+def headline(experiment, about: dict) -> str:
+    """What the run is and how far it got."""
+    episodes = about.get("episodes", len(about.get("returns", [])))
+    where = "checkpoint" if "returns" in about else "model"  # a checkpoint's state keeps every return
+    text = (f"{about['experiment']} {about['algo']} ({about.get('preset', '?')} preset, seed {about.get('seed', '?')}): "
+            f"{where} at {about['env_steps']:,} env steps, {episodes:,} episodes, "
+            f"{about.get('wall_seconds', 0) / 3600:.1f} h of training")
+    if "stopped_by" in about:
+        text += f"; stopped by {about['stopped_by']}"
+    return text
+
+
+def block_line(experiment, part: pd.DataFrame, partial: pd.DataFrame | None) -> str:
+    """One block of full episodes (and the partial ones logged over the same episodes)."""
+    first, last = int(part["episode"].iloc[0]), int(part["episode"].iloc[-1])
+    words = [f"episodes {first:,}-{last:,} (to env step {int(part['env_steps'].iloc[-1]):,}):"]
+    if "success" in part and part["success"].notna().any():
+        wins = int(part["success"].sum())
+        words.append(f"{experiment.success_key} {wins}/{len(part)} ({wins / len(part):.1%})")
+    if experiment.progress_key and experiment.progress_key in part:
+        words.append(f"mean {experiment.progress_key} {part[experiment.progress_key].mean():,.0f}")
+    words.append(f"mean return {part['total_points'].mean():.1f}")
+    if partial is not None and len(partial):
+        wins = f" ({int(partial['success'].sum())} {experiment.success_key})" if "success" in partial else ""
+        words.append(f"| {experiment.partial_key} {len(partial)}{wins}")
+    return " ".join(words)
+
+
+def cause_line(experiment, span: pd.DataFrame, most: int = 5) -> str | None:
+    """The commonest causes of failure (``Experiment.cause_key``) in ``span``, as shares."""
+    key = experiment.cause_key
+    if not key or key not in span or span[key].isna().all():
+        return None
+    causes = span[key].dropna().map(experiment.cause_name).value_counts()
+    shares = ", ".join(f"{name} {n / causes.sum():.0%}" for name, n in causes.head(most).items())
+    return f"{key} over these episodes ({int(causes.sum()):,} failures): {shares}"
+
+
+def _partial_between(df: pd.DataFrame, experiment, part: pd.DataFrame) -> pd.DataFrame | None:
+    key = experiment.partial_key
+    if not key or key not in df:
+        return None
+    between = df["episode"].between(part["episode"].iloc[0], part["episode"].iloc[-1])
+    return df[between & (df[key] == 1)]

@@ -1,0 +1,58 @@
+"""`main.py status RUN_DIR`: where a run stands, from its CSV tables."""
+from pathlib import Path
+
+import pandas as pd
+
+from tests.mario_ppo.test_plots import write_run
+from tests.test_cli import run
+
+ROOT = Path(__file__).resolve().parents[2]
+HEADER = "episode,total_points,av_latest_points,target_ave_scores,env_steps,x_pos,success,success_share,restarted,killed_by"
+
+
+def test_status_counts_flags_per_block_of_full_episodes_and_restarts_beside_them(capsys, tmp_path):
+    rows = [HEADER]
+    for i in range(1, 61):  # every 4th episode restarted; full episodes win when i % 5 == 0
+        restarted = int(i % 4 == 0)
+        won = int(i % 5 == 0)
+        cause = "" if won else (-1 if i % 3 else 10)  # fell, or a grey Cheep-cheep
+        rows.append(f"{i},{10 * i},0,0,{100 * i},{20 * i},{won},0,{restarted},{cause}")
+    write_run(tmp_path, rows)
+    code, out, err = run(capsys, "status", str(tmp_path), "--block", "20", "--blocks", "2")
+    assert code == 0, err
+    lines = out.splitlines()
+    assert lines[0] == ("mario_ppo ppo (default preset, seed 0): checkpoint at 28,672 env steps, 60 episodes, "
+                        "1.5 h of training")
+    df = pd.read_csv(tmp_path / "metrics.csv")
+    full = df[df.restarted == 0]  # 45 episodes: the newest 40 in 2 blocks of 20
+    for line, part in zip(lines[1:3], (full.iloc[5:25], full.iloc[25:45])):
+        first, last = part.episode.iloc[0], part.episode.iloc[-1]
+        partial = df[df.episode.between(first, last) & (df.restarted == 1)]
+        assert line.startswith(f"episodes {first}-{last} (to env step {100 * last:,}): "
+                               f"flag_get {part.success.sum()}/20 ({part.success.sum() / 20:.1%}) "
+                               f"mean x_pos {part.x_pos.mean():,.0f}")
+        assert line.endswith(f"| restarted {len(partial)} ({partial.success.sum()} flag_get)")
+    span = df[df.episode >= full.episode.iloc[5]].killed_by.dropna()
+    fell = (span == -1).mean()
+    assert lines[3] == (f"killed_by over these episodes ({len(span)} failures): fell {fell:.0%}, "
+                        f"grey Cheep-cheep {1 - fell:.0%}")
+    assert len(lines) == 4
+
+
+def test_status_of_a_shipped_level_reads_its_meta_and_ends_at_its_last_episode(capsys):
+    folder = ROOT / "saved_networks" / "mario_ppo" / "1-4"
+    code, out, err = run(capsys, "status", str(folder), "--block", "100", "--blocks", "1")
+    assert code == 0, err
+    head, block = out.splitlines()
+    assert head.startswith("mario_ppo ppo (default preset, seed 0): model at 901,120 env steps, ")
+    df = pd.read_csv(folder / "metrics.csv").tail(100)
+    wins = df.success.sum()
+    assert block.startswith(f"episodes {df.episode.iloc[0]:,}-{df.episode.iloc[-1]:,} ")
+    assert f"flag_get {wins}/100 ({wins / 100:.1%})" in block
+
+
+def test_status_of_a_folder_that_is_not_a_run_is_one_line(capsys, tmp_path):
+    code, out, err = run(capsys, "status", str(tmp_path))
+    assert code == 2 and err.strip() == f"error: no metrics.csv in {tmp_path}; give a run folder such as runs/<name>"
+    code, _, err = run(capsys, "status", str(tmp_path), "--block", "0")
+    assert code == 2 and len(err.strip().splitlines()) == 1 and "--block" in err
