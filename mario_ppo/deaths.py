@@ -38,6 +38,8 @@ ENEMY_NAMES = {
     0x10: "Green Paratroopa", 0x11: "Lakitu", 0x12: "Spiny", 0x14: "flying Cheep-cheep",
     0x15: "Bowser's flame", 0x1B: "Firebar", 0x1C: "Firebar", 0x1D: "Firebar", 0x1E: "Firebar",
     0x1F: "long Firebar", 0x2D: "Bowser", 0x33: "Bullet Bill",
+    # the lifts are objects in the same slots: one nearest a death says where it came, not who dealt it
+    **{code: "a lift" for code in range(0x24, 0x2D)},
 }
 
 

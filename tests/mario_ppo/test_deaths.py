@@ -52,8 +52,8 @@ def test_a_fall_and_the_clock_come_before_any_enemy():
     ram = dying_ram(clock=(0, 0, 0))
     put_enemy(ram, 0, 0x06, 2, 0x40, 120)
     assert killed_by(ram) == TIME_UP
-    assert [cause_name(c) for c in (FELL, TIME_UP, 0x1B, 0x1F, 0x2C)] == [
-        "fell", "time up", "Firebar", "long Firebar", "enemy 0x2C"]
+    assert [cause_name(c) for c in (FELL, TIME_UP, 0x1B, 0x1F, 0x24, 0x28, 0x2C, 0x30)] == [
+        "fell", "time up", "Firebar", "long Firebar", "a lift", "a lift", "a lift", "enemy 0x30"]
 
 
 class _Ends(gym.Env):
