@@ -14,12 +14,13 @@ import pandas as pd
 from rlcore.plotting import full_episodes, read_table
 
 
-def run_status(run_dir: str | Path, experiment, about: dict, block: int = 200, blocks: int = 6) -> list[str]:
+def run_status(run_dir: str | Path, experiment, about: dict, block: int = 200,
+               blocks: int = 6) -> list[str]:
     """The lines ``main.py status`` prints: a headline from ``about`` (a checkpoint's state or a
     model's meta.json), then one line per block of ``block`` full episodes, the last ``blocks`` of
     them, then the commonest causes of failure over those blocks' span (all episodes)."""
     df = read_table(Path(run_dir) / "metrics.csv", "episode", "env_steps", "total_points")
-    lines = [headline(experiment, about)]
+    lines = [headline(about)]
     full = full_episodes(df, experiment.partial_key)
     recent = full.tail(block * blocks)
     if recent.empty:
@@ -34,13 +35,13 @@ def run_status(run_dir: str | Path, experiment, about: dict, block: int = 200, b
     return lines + ([causes] if causes else [])
 
 
-def headline(experiment, about: dict) -> str:
+def headline(about: dict) -> str:
     """What the run is and how far it got."""
     episodes = about.get("episodes", len(about.get("returns", [])))
     where = "checkpoint" if "returns" in about else "model"  # a checkpoint's state keeps every return
-    text = (f"{about['experiment']} {about['algo']} ({about.get('preset', '?')} preset, seed {about.get('seed', '?')}): "
-            f"{where} at {about['env_steps']:,} env steps, {episodes:,} episodes, "
-            f"{about.get('wall_seconds', 0) / 3600:.1f} h of training")
+    text = (f"{about['experiment']} {about['algo']} ({about.get('preset', '?')} preset, "
+            f"seed {about.get('seed', '?')}): {where} at {about['env_steps']:,} env steps, "
+            f"{episodes:,} episodes, {about.get('wall_seconds', 0) / 3600:.1f} h of training")
     if "stopped_by" in about:
         text += f"; stopped by {about['stopped_by']}"
     return text

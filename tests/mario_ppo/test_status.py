@@ -7,7 +7,8 @@ from tests.mario_ppo.test_plots import write_run
 from tests.test_cli import run
 
 ROOT = Path(__file__).resolve().parents[2]
-HEADER = "episode,total_points,av_latest_points,target_ave_scores,env_steps,x_pos,success,success_share,restarted,killed_by"
+HEADER = ("episode,total_points,av_latest_points,target_ave_scores,env_steps,x_pos,success,success_share,"
+          "restarted,killed_by")
 
 
 def test_status_counts_flags_per_block_of_full_episodes_and_restarts_beside_them(capsys, tmp_path):
