@@ -11,6 +11,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from rlcore.evaluation import count_causes
 from rlcore.plotting import full_episodes, read_table
 
 
@@ -68,9 +69,10 @@ def cause_line(experiment, span: pd.DataFrame, most: int = 5) -> str | None:
     key = experiment.cause_key
     if not key or key not in span or span[key].isna().all():
         return None
-    causes = span[key].dropna().map(experiment.cause_name).value_counts()
-    shares = ", ".join(f"{name} {n / causes.sum():.0%}" for name, n in causes.head(most).items())
-    return f"{key} over these episodes ({int(causes.sum()):,} failures): {shares}"
+    causes = count_causes(span[[key]].to_dict("records"), key, experiment.cause_name)
+    total = sum(n for _, n in causes)
+    shares = ", ".join(f"{name} {n / total:.0%}" for name, n in causes[:most])
+    return f"{key} over these episodes ({total:,} failures): {shares}"
 
 
 def _partial_between(df: pd.DataFrame, experiment, part: pd.DataFrame) -> pd.DataFrame | None:
