@@ -1,4 +1,5 @@
-"""Episode loop for the Q-learning agents (DQN, Double, Dueling, Dueling Double)."""
+"""Training of the Q-learning agents (DQN, Double, Dueling, Dueling Double): epsilon-greedy acting in
+the shared off-policy episode loop (:mod:`rlcore.trainers.off_policy`)."""
 from __future__ import annotations
 
 import math
@@ -10,8 +11,8 @@ import numpy as np
 from rlcore.agents.dqn import DQNAgent
 from rlcore.replay import ReplayMemory
 from rlcore.trainers import checkpoints
-from rlcore.trainers.divergence import reported_divergence
 from rlcore.trainers.episodes import episode_means
+from rlcore.trainers.off_policy import run_episodes
 from rlcore.trainers.session import TrainingSession
 from rlcore.trainers.spec import RunSpec
 
@@ -25,56 +26,51 @@ def train(spec: RunSpec) -> Path:
     agent = DQNAgent(obs_dim, n_actions, cfg)
     memory = ReplayMemory(cfg.buffer_size, (obs_dim,))
     rng = np.random.default_rng(spec.seed)
-    epsilon = cfg.eps_start
-
     state, arrays = checkpoints.restore(spec, agent, rng, memory)
-    if state is not None:
-        epsilon = state["epsilon"]
     session = TrainingSession(spec, state, resumed_arrays=arrays)
-    grad_steps = int(state["grad_steps"]) if state else 0
+    learner = EpsilonGreedy(agent, cfg, rng, state)
 
     def checkpoint():
-        checkpoints.save(session, agent, rng, memory, epsilon=epsilon, grad_steps=grad_steps)
+        checkpoints.save(session, agent, rng, memory, **learner.counters())
 
-    update_period = cfg.learn_every * cfg.updates_per_call
-    # a resumed run reseeds from its episode count
-    first_seed = session.fresh_env_seeds(1)[0]
-    with session.interruptible():
-        while not session.should_stop():
-            obs, _ = env.reset(seed=first_seed)
-            first_seed = None  # later episodes continue the env's own RNG
-            episode_return, losses = 0.0, []
-            while True:
-                if cfg.eps_schedule == "steps":
-                    epsilon = step_epsilon(cfg, session.env_steps)
-                action = agent.act(obs, epsilon, rng)
-                next_obs, reward, terminated, truncated, _ = env.step(action)
-                memory.add(obs, action, reward, next_obs, terminated)
-                session.env_steps += 1
-                episode_return += reward
-                obs = next_obs
-                if session.env_steps % update_period == 0 and len(memory) >= max(cfg.batch_size,
-                                                                                  cfg.learning_starts):
-                    stacked = memory.sample_stacked(cfg.updates_per_call, cfg.batch_size, rng)
-                    with reported_divergence(session, "DQN", "lower --lr"):
-                        losses.append(agent.train_steps(*stacked))
-                    grad_steps += cfg.updates_per_call
-                session.maybe_evaluate(agent.greedy_actions, agent.q_network.get_weights)
-                if terminated or truncated or session.stop_requested:
-                    break
-            if session.stop_requested:  # partial episode: not counted; its transitions stay in replay
-                break
-            if cfg.eps_schedule == "episode":
-                epsilon = max(cfg.eps_end, epsilon * cfg.eps_decay)
-            mean_losses = episode_means(losses, ("loss", "q_mean"))
-            session.end_episode(episode_return, {"epsilon": epsilon, "grad_steps": grad_steps, **mean_losses})
-            if session.book.episodes % cfg.checkpoint_every == 0:
-                checkpoint()
-    env.close()
+    run_episodes(session, env, memory, rng, learner, cfg, checkpoint, agent.greedy_actions,
+                 agent.q_network.get_weights)
     return session.conclude(checkpoint, lambda folder: [agent.save(folder)], agent.q_network.set_weights)
+
+
+class EpsilonGreedy:
+    """The DQN family's part of the episode loop: epsilon-greedy actions, with epsilon decayed per
+    episode (article 000) or by env steps (the PyTorch tutorial, article 003)."""
+    name, divergence_hint = "DQN", "lower --lr"
+
+    def __init__(self, agent: DQNAgent, cfg, rng: np.random.Generator, state: dict | None):
+        self.agent, self.cfg, self.rng = agent, cfg, rng
+        self.epsilon = state["epsilon"] if state else cfg.eps_start
+        self.grad_steps = int(state["grad_steps"]) if state else 0
+        self.update_period = cfg.learn_every * cfg.updates_per_call
+
+    def act(self, obs, env_steps):
+        if self.cfg.eps_schedule == "steps":
+            self.epsilon = step_epsilon(self.cfg, env_steps)
+        return self.agent.act(obs, self.epsilon, self.rng)
+
+    def observe(self, obs):
+        pass
+
+    def learn(self, batches):
+        report = self.agent.train_steps(*batches)
+        self.grad_steps += self.cfg.updates_per_call
+        return report
+
+    def episode_row(self, losses, episode_steps, info):
+        if self.cfg.eps_schedule == "episode":
+            self.epsilon = max(self.cfg.eps_end, self.epsilon * self.cfg.eps_decay)
+        return {"epsilon": self.epsilon, "grad_steps": self.grad_steps, **episode_means(losses, ("loss", "q_mean"))}
+
+    def counters(self):
+        return {"epsilon": self.epsilon, "grad_steps": self.grad_steps}
 
 
 def step_epsilon(cfg, env_steps: int) -> float:
     """The PyTorch tutorial's schedule: end + (start - end) * exp(-steps / decay_steps)."""
     return cfg.eps_end + (cfg.eps_start - cfg.eps_end) * math.exp(-env_steps / cfg.eps_decay_steps)
-

@@ -1,4 +1,5 @@
-"""Step loop for SAC: one env step per gradient step, after ``learning_starts`` random steps.
+"""Training of SAC: random actions for ``learning_starts`` env steps, then the policy's samples, in
+the shared off-policy episode loop (:mod:`rlcore.trainers.off_policy`), one gradient step per env step.
 
 Like TF-Agents' driver, a time-limit truncation still bootstraps (only ``terminated``, a fall,
 stops it). The replay memory is saved beside each checkpoint (``replay.npz``), so a resumed run
@@ -14,8 +15,8 @@ import numpy as np
 from rlcore.agents.sac import SACAgent
 from rlcore.replay import ReplayMemory
 from rlcore.trainers import checkpoints
-from rlcore.trainers.divergence import reported_divergence
 from rlcore.trainers.episodes import episode_means
+from rlcore.trainers.off_policy import run_episodes
 from rlcore.trainers.session import TrainingSession
 from rlcore.trainers.spec import RunSpec
 
@@ -28,58 +29,50 @@ def train(spec: RunSpec) -> Path:
     agent = SACAgent(obs_dim, act_dim, cfg)
     memory = ReplayMemory(cfg.buffer_size, (obs_dim,), action_shape=(act_dim,), action_dtype=np.float32)
     rng = np.random.default_rng(spec.seed)
-
     state, arrays = checkpoints.restore(spec, agent, rng, memory)
     if state is not None:
         agent.log_alpha.assign(state["log_alpha"])
         agent.restore_obs_stats(state.get("obs_stats"))
     session = TrainingSession(spec, state, resumed_arrays=arrays)
-    grad_steps = int(state["grad_steps"]) if state else 0
+    learner = SoftActorCritic(agent, cfg, rng, state, spec.experiment.info_keys)
 
     def checkpoint():
-        checkpoints.save(session, agent, rng, memory, grad_steps=grad_steps,
-                         log_alpha=float(agent.log_alpha.numpy()),
-                         obs_stats=agent.obs_stats_state())
+        checkpoints.save(session, agent, rng, memory, **learner.counters())
 
-    k = cfg.updates_per_call
-    # a resumed run reseeds from its episode count
-    first_seed = session.fresh_env_seeds(1)[0]
-    with session.interruptible():
-        while not session.should_stop():
-            obs, _ = env.reset(seed=first_seed)
-            agent.observe(obs)
-            first_seed = None  # later episodes continue the env's own RNG
-            episode_return, episode_steps, losses = 0.0, 0, []
-            while True:
-                if session.env_steps < cfg.learning_starts:
-                    action = rng.uniform(-1.0, 1.0, act_dim).astype(np.float32)
-                else:
-                    action = agent.act(obs[None], rng)[0]
-                next_obs, reward, terminated, truncated, info = env.step(action)
-                memory.add(obs, action, reward, next_obs, terminated)
-                agent.observe(next_obs)
-                session.env_steps += 1
-                episode_return += reward
-                episode_steps += 1
-                obs = next_obs
-                # len(memory): after a resume without its replay file, the memory refills first
-                if len(memory) >= max(cfg.learning_starts, cfg.batch_size) and session.env_steps % k == 0:
-                    stacked = memory.sample_stacked(k, cfg.batch_size, rng)
-                    with reported_divergence(session, "SAC", "lower the learning rates"):
-                        losses.append(agent.train_steps(*stacked, rng))
-                    grad_steps += k
-                session.maybe_evaluate(agent.greedy_actions, agent.get_weights)
-                if terminated or truncated or session.stop_requested:
-                    break
-            if session.stop_requested:  # partial episode: not counted; its transitions stay in replay
-                break
-            means = episode_means(losses, ("critic_loss", "actor_loss", "alpha", "entropy", "q_mean"))
-            # episode_steps: how long it stood (Minitaur: a fall ends it before the time limit)
-            ends = {key: float(info.get(key, float("nan"))) for key in spec.experiment.info_keys}
-            session.end_episode(episode_return, {"episode_steps": episode_steps, **ends, "grad_steps": grad_steps,
-                                                 **means})
-            if session.book.episodes % cfg.checkpoint_every == 0:
-                checkpoint()
-    env.close()
+    run_episodes(session, env, memory, rng, learner, cfg, checkpoint, agent.greedy_actions, agent.get_weights)
     return session.conclude(checkpoint, agent.save, agent.set_weights)
 
+
+class SoftActorCritic:
+    """SAC's part of the episode loop: uniform random actions before ``learning_starts``, then
+    samples of the policy; every observation goes to the running statistics (``obs_norm``)."""
+    name, divergence_hint = "SAC", "lower the learning rates"
+
+    def __init__(self, agent: SACAgent, cfg, rng: np.random.Generator, state: dict | None,
+                 info_keys: tuple[str, ...]):
+        self.agent, self.cfg, self.rng, self.info_keys = agent, cfg, rng, info_keys
+        self.grad_steps = int(state["grad_steps"]) if state else 0
+        self.update_period = cfg.updates_per_call  # one gradient step per env step
+
+    def act(self, obs, env_steps):
+        if env_steps < self.cfg.learning_starts:
+            return self.rng.uniform(-1.0, 1.0, self.agent.act_dim).astype(np.float32)
+        return self.agent.act(obs[None], self.rng)[0]
+
+    def observe(self, obs):
+        self.agent.observe(obs)
+
+    def learn(self, batches):
+        report = self.agent.train_steps(*batches, self.rng)
+        self.grad_steps += self.cfg.updates_per_call
+        return report
+
+    def episode_row(self, losses, episode_steps, info):
+        # episode_steps: how long it stood (Minitaur: a fall ends it before the time limit)
+        ends = {key: float(info.get(key, float("nan"))) for key in self.info_keys}
+        return {"episode_steps": episode_steps, **ends, "grad_steps": self.grad_steps,
+                **episode_means(losses, ("critic_loss", "actor_loss", "alpha", "entropy", "q_mean"))}
+
+    def counters(self):
+        return {"grad_steps": self.grad_steps, "log_alpha": float(self.agent.log_alpha.numpy()),
+                "obs_stats": self.agent.obs_stats_state()}
