@@ -148,7 +148,9 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
                             description="Print where a run stands from its CSV tables: per block of "
                                         "episodes that started where evaluations start, the success "
                                         "share, mean progress and mean return, the restarted episodes "
-                                        "beside them, and what ended the failures.")
+                                        "beside them, and what ended the failures; for a run without a "
+                                        "goal (Minitaur), the mean episode length and metres walked; "
+                                        "then the last periodic evaluations.")
     status.add_argument("run_dir", help="a run folder, e.g. long_runs/mario_ppo/2-2")
     status.add_argument("--block", type=COUNT, default=200, help="episodes per block (default 200)")
     status.add_argument("--blocks", type=COUNT, default=6, help="how many of the newest blocks (default 6)")

@@ -2,8 +2,10 @@
 
 For a run that lasts many sessions (a Mario level): per block of episodes that started where
 evaluations start, the success share, the mean progress and the mean return; the episodes that started
-elsewhere (Mario's restarts) beside them; and what ended the failures. It reads the same tables as
-``main.py plot`` and works on a run that is training, interrupted or finished. TensorFlow-free.
+elsewhere (Mario's restarts) beside them; and what ended the failures. For a run without a goal
+(Minitaur): per block, the mean return, episode length and info keys (metres walked), and the last
+periodic evaluations. It reads the same tables as ``main.py plot`` and works on a run that is
+training, interrupted or finished. TensorFlow-free.
 """
 from __future__ import annotations
 
@@ -33,7 +35,7 @@ def run_status(run_dir: str | Path, experiment, about: dict, block: int = 200,
         part = recent.iloc[begin:end]
         lines.append(block_line(experiment, part, _partial_between(df, experiment, part)))
     causes = cause_line(experiment, span)
-    return lines + ([causes] if causes else [])
+    return lines + ([causes] if causes else []) + evaluation_lines(Path(run_dir) / "evals.csv")
 
 
 def headline(about: dict) -> str:
@@ -58,10 +60,30 @@ def block_line(experiment, part: pd.DataFrame, partial: pd.DataFrame | None) -> 
     if experiment.progress_key and experiment.progress_key in part:
         words.append(f"mean {experiment.progress_key} {part[experiment.progress_key].mean():,.0f}")
     words.append(f"mean return {part['total_points'].mean():.1f}")
+    if "episode_steps" in part:  # SAC: how long it stood (a Minitaur fall ends it early)
+        words.append(f"mean length {part['episode_steps'].mean():,.0f} steps")
+    if not experiment.success_key:  # Minitaur: x, the metres walked
+        words += [f"mean {key} {part[key].mean():,.2f}" for key in experiment.info_keys
+                  if key in part and key != experiment.cause_key and part[key].notna().any()]
     if partial is not None and len(partial):
         wins = f" ({int(partial['success'].sum())} {experiment.success_key})" if "success" in partial else ""
         words.append(f"| {experiment.partial_key} {len(partial)}{wins}")
     return " ".join(words)
+
+
+def evaluation_lines(evals_csv: Path, last: int = 3) -> list[str]:
+    """The last periodic evaluations (``evals.csv``), if the run has any."""
+    if not evals_csv.is_file():
+        return []
+    evals = read_table(evals_csv, "env_steps", "eval_mean", "eval_std").tail(last)
+    lines = []
+    for row in evals.itertuples():
+        line = f"evaluation at env step {int(row.env_steps):,}: mean {row.eval_mean:.2f} +- {row.eval_std:.2f}"
+        share = getattr(row, "eval_time_limit_share", float("nan"))
+        if pd.notna(share):
+            line += f", {share:.0%} of its episodes to the time limit"
+        lines.append(line)
+    return lines
 
 
 def cause_line(experiment, span: pd.DataFrame, most: int = 5) -> str | None:
