@@ -63,6 +63,10 @@ def _spec_from_args(args):
         print(f"resuming {run_dir} at episode {len(state['returns'])}, env step {state['env_steps']}")
         return spec
     run_dir = Path(args.run_dir) if args.run_dir else new_run_dir(args.experiment, args.algo, args.seed)
+    held = [name for name in ("checkpoint.npz", "metrics.csv") if (run_dir / name).is_file()]
+    if held:  # a new run there would append to its tables and overwrite its checkpoint
+        raise UserError(f"--run-dir {run_dir} already holds a run ({held[0]}); continue it with --resume "
+                        f"{run_dir}, or give another --run-dir")
     return build_spec(args.experiment, args.algo, run_dir=run_dir, **common)
 
 

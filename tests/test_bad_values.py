@@ -265,3 +265,19 @@ def test_publish_replaces_the_shipped_folder_whole(tmp_path):
                                                         "rollouts.csv"]
     assert (target / "meta.json").read_text() == "new meta.json"
     assert [p.name for p in target.parent.iterdir()] == ["dqn"]  # no temporary folder left
+
+
+def test_a_new_run_into_a_folder_that_holds_a_run_is_refused_and_leaves_it_as_it_was(capsys, tmp_path):
+    """Starting again with the first command of a long run (not --resume) must not touch its files."""
+    run_dir = tmp_path / "run"
+    run_dir.mkdir()
+    (run_dir / "metrics.csv").write_text("episode,total_points\n1,2.0\n")
+    (run_dir / "checkpoint.npz").write_bytes(b"a checkpoint")
+    code, out, err = run(capsys, "train", "cartpole", "dqn", "--episodes", "1", "--wandb", "off",
+                         "--run-dir", str(run_dir))
+    assert code == 2, (out, err)
+    assert err.strip() == (f"error: --run-dir {run_dir} already holds a run (checkpoint.npz); continue it "
+                           f"with --resume {run_dir}, or give another --run-dir")
+    assert sorted(p.name for p in run_dir.iterdir()) == ["checkpoint.npz", "metrics.csv"]
+    assert (run_dir / "checkpoint.npz").read_bytes() == b"a checkpoint"
+    assert (run_dir / "metrics.csv").read_text() == "episode,total_points\n1,2.0\n"
