@@ -50,7 +50,7 @@ def _budget_overrides(args) -> dict:
 def _spec_from_args(args):
     from rlcore.hparams import overrides_from_args
     from rlcore.run import build_spec
-    from rlcore.trainers.spec import latest_run_dir, new_run_dir
+    from rlcore.trainers.spec import CHECKPOINT_FILE, latest_run_dir, new_run_dir
 
     overrides = {**overrides_from_args(args), **_budget_overrides(args)}
     common = dict(preset=args.preset, seed=args.seed, overrides=overrides, wandb_mode=args.wandb,
@@ -63,7 +63,7 @@ def _spec_from_args(args):
         print(f"resuming {run_dir} at episode {len(state['returns'])}, env step {state['env_steps']}")
         return spec
     run_dir = Path(args.run_dir) if args.run_dir else new_run_dir(args.experiment, args.algo, args.seed)
-    held = [name for name in ("checkpoint.npz", "metrics.csv") if (run_dir / name).is_file()]
+    held = [name for name in (CHECKPOINT_FILE, "metrics.csv") if (run_dir / name).is_file()]
     if held:  # a new run there would append to its tables and overwrite its checkpoint
         raise UserError(f"--run-dir {run_dir} already holds a run ({held[0]}); continue it with --resume "
                         f"{run_dir}, or give another --run-dir")

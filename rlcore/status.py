@@ -64,7 +64,7 @@ def block_line(experiment, part: pd.DataFrame, partial: pd.DataFrame | None) -> 
         words.append(f"mean length {part['episode_steps'].mean():,.0f} steps")
     if not experiment.success_key:  # Minitaur: x, the metres walked
         words += [f"mean {key} {part[key].mean():,.2f}" for key in experiment.info_keys
-                  if key in part and key != experiment.cause_key and part[key].notna().any()]
+                  if key in part and part[key].notna().any()]
     if partial is not None and len(partial):
         wins = f" ({int(partial['success'].sum())} {experiment.success_key})" if "success" in partial else ""
         words.append(f"| {experiment.partial_key} {len(partial)}{wins}")

@@ -56,7 +56,7 @@ def run_episodes(session: TrainingSession, env, memory: ReplayMemory, rng: np.ra
             obs, _ = env.reset(seed=first_seed)
             learner.observe(obs)
             first_seed = None  # later episodes continue the env's own RNG
-            episode_return, episode_steps, losses, info = 0.0, 0, [], {}
+            episode_return, episode_steps, losses = 0.0, 0, []
             while True:
                 action = learner.act(obs, session.env_steps)
                 next_obs, reward, terminated, truncated, info = env.step(action)
