@@ -7,7 +7,8 @@
 A trial calls :func:`rlcore.run.run_training`, the function ``main.py train`` calls, and reports
 every logged row to Tune as it comes. Fault tolerance lives in the run folder, not in Tune: a trial
 that starts where a checkpoint exists resumes it (so a trial whose worker was killed and that Tune
-restarts continues its counters), and a trial whose ``model/meta.json`` exists is finished and is
+restarts continues its counters; one killed before its first checkpoint starts over, its tables
+cleared), and a trial whose ``model/meta.json`` exists is finished and is
 not run again (``--resume``). Ctrl-C or SIGTERM writes ``sweeps/<name>/STOP``: every running trial
 stops at its next safe point with a checkpoint, and the sweep ends (then Ray is shut down; a driver
 killed outright would leave Ray's workers running).
@@ -156,6 +157,9 @@ def run_trial(trial: dict, sweep: dict, modules: dict, report) -> dict:
     from rlcore.trainers.stopping import Interrupted
 
     resume = (run_dir / "checkpoint.npz").is_file()
+    if not resume:  # a start killed before its first checkpoint: its rows go, the run begins again
+        for table in run_dir.glob("*.csv"):
+            table.unlink()
     values = {k: v for k, v in trial.items() if k != "seed"}
     command = (f"python main.py sweep {sweep.experiment} {sweep.algo} --name {sweep.name} "
                f"(trial {trial_name(trial)}{', resumed' if resume else ''})")

@@ -240,3 +240,21 @@ def test_report_refuses_a_folder_that_mixes_experiments_or_algorithms(tmp_path, 
     assert not (tmp_path / "runs" / "report.md").exists()
     (tmp_path / "runs" / "b" / "model" / "meta.json").unlink()  # the rest: one experiment and algorithm
     assert [r["score"] for r in load_runs(tmp_path / "runs")] == [200.0, 250.0]
+
+
+def test_a_trial_killed_before_its_first_checkpoint_starts_over_without_its_old_rows(tmp_path):
+    """No checkpoint means the trial starts from episode 1 again: rows logged by the killed start are
+    not kept under the new run's (they would repeat episode numbers and mix two runs' curves)."""
+    import dataclasses
+
+    from rlcore.sweep import run_trial
+    sweep = _sweep(tmp_path, "early", seeds=(0,))
+    trial = tmp_path / "early" / "seed=0"
+    trial.mkdir(parents=True)
+    header = "episode,total_points,av_latest_points,target_ave_scores,env_steps,wall_seconds\n"
+    (trial / "metrics.csv").write_text(header + "1,-12345.0,-12345.0,,7,0.1\n2,-12345.0,-12345.0,,9,0.2\n")
+    run_trial({"seed": 0}, dataclasses.asdict(sweep), {"toy": "tests.toy"}, lambda metrics: None)
+    rows = (trial / "metrics.csv").read_text().splitlines()[1:]
+    episodes = [int(line.split(",")[0]) for line in rows]
+    assert episodes == list(range(1, len(episodes) + 1)) and len(episodes) >= 2
+    assert not any("-12345" in line for line in rows)
