@@ -224,7 +224,8 @@ def cmd_status(args) -> int:
 
     run_dir = Path(args.run_dir)
     about = _run_folder(run_dir)
-    print("\n".join(run_status(run_dir, get_experiment(about["experiment"]), about, args.block, args.blocks)))
+    print("\n".join(run_status(run_dir, get_experiment(about["experiment"]), about, args.block, args.blocks,
+                                      args.rollout_block)))
     return 0
 
 

@@ -4,8 +4,10 @@ For a run that lasts many sessions (a Mario level): per block of episodes that s
 evaluations start, the success share, the mean progress and the mean return; the episodes that started
 elsewhere (Mario's restarts) beside them; and what ended the failures. For a run without a goal
 (Minitaur): per block, the mean return, episode length and info keys (metres walked), and the last
-periodic evaluations. It reads the same tables as ``main.py plot`` and works on a run that is
-training, interrupted or finished. TensorFlow-free.
+periodic evaluations. For a PPO run, per block of rollouts (``rollouts.csv``): the same success
+shares beside the size of PPO's updates (entropy, approx KL, clip fraction) and the learning rate, to
+see what a change of settings did. It reads the same tables as ``main.py plot`` and works on a run
+that is training, interrupted or finished. TensorFlow-free.
 """
 from __future__ import annotations
 
@@ -18,10 +20,11 @@ from rlcore.plotting import full_episodes, read_table
 
 
 def run_status(run_dir: str | Path, experiment, about: dict, block: int = 200,
-               blocks: int = 6) -> list[str]:
+               blocks: int = 6, rollout_block: int = 20) -> list[str]:
     """The lines ``main.py status`` prints: a headline from ``about`` (a checkpoint's state or a
     model's meta.json), then one line per block of ``block`` full episodes, the last ``blocks`` of
-    them, then the commonest causes of failure over those blocks' span (all episodes)."""
+    them, then the commonest causes of failure over those blocks' span (all episodes), then the last
+    ``blocks`` blocks of ``rollout_block`` rollouts, then the last periodic evaluations."""
     df = read_table(Path(run_dir) / "metrics.csv", "episode", "env_steps", "total_points")
     lines = [headline(about)]
     full = full_episodes(df, experiment.partial_key)
@@ -35,7 +38,9 @@ def run_status(run_dir: str | Path, experiment, about: dict, block: int = 200,
         part = recent.iloc[begin:end]
         lines.append(block_line(experiment, part, _partial_between(df, experiment, part)))
     causes = cause_line(experiment, span)
-    return lines + ([causes] if causes else []) + evaluation_lines(Path(run_dir) / "evals.csv")
+    return (lines + ([causes] if causes else []) + rollout_lines(Path(run_dir) / "rollouts.csv", experiment,
+                                                                 rollout_block, blocks)
+            + evaluation_lines(Path(run_dir) / "evals.csv"))
 
 
 def headline(about: dict) -> str:
@@ -68,6 +73,42 @@ def block_line(experiment, part: pd.DataFrame, partial: pd.DataFrame | None) -> 
     if partial is not None and len(partial):
         wins = f" ({int(partial['success'].sum())} {experiment.success_key})" if "success" in partial else ""
         words.append(f"| {experiment.partial_key} {len(partial)}{wins}")
+    return " ".join(words)
+
+
+def rollout_lines(rollouts_csv: Path, experiment, block: int, blocks: int) -> list[str]:
+    """Per block of ``block`` rollouts (the newest ``blocks``, whole blocks ending at the newest
+    rollout): the success share of the episodes from the start, the restarted ones beside it, and PPO's
+    update sizes and learning rate, means per update."""
+    if not rollouts_csv.is_file():
+        return []
+    df = read_table(rollouts_csv, "rollout", "episodes_ended", "successes")
+    recent = df.tail(block * blocks)
+    first = len(recent) % block
+    starts = ([0] if first else []) + list(range(first, len(recent), block))
+    return [_rollout_line(experiment, recent.iloc[begin:end])
+            for begin, end in zip(starts, starts[1:] + [len(recent)])]
+
+
+def _rollout_line(experiment, part: pd.DataFrame) -> str:
+    key = experiment.partial_key
+    partial, partial_wins = (part.get(f"{key}_{name}", pd.Series(0, index=part.index)).sum()
+                             for name in ("episodes", "successes"))
+    from_start, wins = int(part["episodes_ended"].sum() - partial), int(part["successes"].sum())
+    words = [f"rollouts {int(part['rollout'].iloc[0])}-{int(part['rollout'].iloc[-1])}:"]
+    label = experiment.success_key or "success"
+    words.append(f"{label} {wins}/{from_start}" + (f" ({wins / from_start:.1%})" if from_start else ""))
+    if partial:
+        words.append(f"| {key} {int(partial_wins)}/{int(partial)} ({partial_wins / partial:.1%})")
+    sizes = [f"{label} {part[name].mean():.{digits}f}"
+             for name, label, digits in (("entropy", "entropy", 2), ("approx_kl", "approx KL", 4),
+                                         ("clip_fraction", "clip fraction", 3))
+             if name in part and part[name].notna().any()]
+    if sizes:
+        words.append("| " + ", ".join(sizes))
+    if "lr" in part and part["lr"].notna().any():
+        rates = part["lr"].dropna()
+        words.append(f"| lr {rates.iloc[0]:.3g}" + (f" -> {rates.iloc[-1]:.3g}" if rates.nunique() > 1 else ""))
     return " ".join(words)
 
 

@@ -44,12 +44,14 @@ def test_status_of_a_shipped_level_reads_its_meta_and_ends_at_its_last_episode(c
     folder = ROOT / "saved_networks" / "mario_ppo" / "1-4"
     code, out, err = run(capsys, "status", str(folder), "--block", "100", "--blocks", "1")
     assert code == 0, err
-    head, block = out.splitlines()
+    head, block, rollouts = out.splitlines()  # one block of episodes, one of 20 rollouts
     assert head.startswith("mario_ppo ppo (default preset, seed 0): model at 901,120 env steps, ")
     df = pd.read_csv(folder / "metrics.csv").tail(100)
     wins = df.success.sum()
     assert block.startswith(f"episodes {df.episode.iloc[0]:,}-{df.episode.iloc[-1]:,} ")
     assert f"flag_get {wins}/100 ({wins / 100:.1%})" in block
+    last = pd.read_csv(folder / "rollouts.csv").rollout.iloc[-1]
+    assert rollouts.startswith(f"rollouts {last - 19}-{last}: flag_get ")
 
 
 def test_status_of_a_folder_that_is_not_a_run_is_one_line(capsys, tmp_path):
@@ -57,3 +59,26 @@ def test_status_of_a_folder_that_is_not_a_run_is_one_line(capsys, tmp_path):
     assert code == 2 and err.strip() == f"error: no metrics.csv in {tmp_path}; give a run folder such as runs/<name>"
     code, _, err = run(capsys, "status", str(tmp_path), "--block", "0")
     assert code == 2 and len(err.strip().splitlines()) == 1 and "--block" in err
+
+
+def test_status_shows_blocks_of_rollouts_with_update_sizes_and_the_learning_rate(capsys, tmp_path):
+    """Whole blocks end at the newest rollout; a rate changed inside a block shows as first -> last."""
+    write_run(tmp_path, [HEADER, "1,10,0,0,100,20,1,0,0,"])
+    rows = ["rollout,env_steps,episodes_ended,successes,restarted_episodes,restarted_successes,entropy,"
+            "approx_kl,clip_fraction,lr"]
+    for r in range(1, 8):  # 7 rollouts: blocks of 3 are 1, 2-4, 5-7
+        rows.append(f"{r},{4096 * r},{10 + r},{r},4,{r % 3},{1.0 - r / 100},{r / 1000},{r / 100},"
+                    f"{1e-4 if r < 6 else 5e-5}")
+    (tmp_path / "rollouts.csv").write_text("\n".join(rows) + "\n")
+    code, out, err = run(capsys, "status", str(tmp_path), "--rollout-block", "3", "--blocks", "2")
+    assert code == 0, err
+    lines = out.splitlines()[-2:]
+    df = pd.read_csv(tmp_path / "rollouts.csv")
+    for line, part in zip(lines, (df.iloc[1:4], df.iloc[4:7])):
+        wins, starts = part.successes.sum(), (part.episodes_ended - part.restarted_episodes).sum()
+        rwins = part.restarted_successes.sum()
+        assert line.startswith(f"rollouts {part.rollout.iloc[0]}-{part.rollout.iloc[-1]}: "
+                               f"flag_get {wins}/{starts} ({wins / starts:.1%}) | restarted {rwins}/12 "
+                               f"({rwins / 12:.1%}) | entropy {part.entropy.mean():.2f}, "
+                               f"approx KL {part.approx_kl.mean():.4f}, clip fraction {part.clip_fraction.mean():.3f}")
+    assert lines[0].endswith("| lr 0.0001") and lines[1].endswith("| lr 0.0001 -> 5e-05")
