@@ -106,10 +106,19 @@ def _rollout_line(experiment, part: pd.DataFrame) -> str:
              if name in part and part[name].notna().any()]
     if sizes:
         words.append("| " + ", ".join(sizes))
-    if "lr" in part and part["lr"].notna().any():
-        rates = part["lr"].dropna()
-        words.append(f"| lr {rates.iloc[0]:.3g}" + (f" -> {rates.iloc[-1]:.3g}" if rates.nunique() > 1 else ""))
+    settings = [_setting(part, name, label) for name, label in (("lr", "lr"), ("entropy_coef", "entropy weight"))]
+    if any(settings):
+        words.append("| " + ", ".join(text for text in settings if text))
     return " ".join(words)
+
+
+def _setting(part: pd.DataFrame, name: str, label: str) -> str | None:
+    """A setting over a block of rollouts: its value, or first -> last when a resume changed it
+    (rows logged before the code kept that column leave it empty)."""
+    if name not in part or part[name].isna().all():
+        return None
+    values = part[name].dropna()
+    return f"{label} {values.iloc[0]:.3g}" + (f" -> {values.iloc[-1]:.3g}" if values.nunique() > 1 else "")
 
 
 def evaluation_lines(evals_csv: Path, last: int = 3) -> list[str]:

@@ -114,7 +114,8 @@ def train(spec: RunSpec) -> Path:
             rollouts += 1
             seconds = {"collect_seconds": round(collected - started, 3),  # where a rollout's time goes
                        "update_seconds": round(time.perf_counter() - collected, 3)}
-            session.log_rollout(rollouts, {**log.row(), **losses, "lr": lr.rate(), **seconds})
+            session.log_rollout(rollouts, {**log.row(), **losses, "lr": lr.rate(),
+                                           "entropy_coef": cfg.entropy_coef, **seconds})
             line = log.line(rollouts, session.env_steps, book, cfg.window)
             tqdm.write(line + f" | loss {losses['loss']:.3f} entropy {losses['entropy']:.2f}")
             halved = lr.observe(book.settled_success_share)

@@ -62,13 +62,13 @@ def test_status_of_a_folder_that_is_not_a_run_is_one_line(capsys, tmp_path):
 
 
 def test_status_shows_blocks_of_rollouts_with_update_sizes_and_the_learning_rate(capsys, tmp_path):
-    """Whole blocks end at the newest rollout; a rate changed inside a block shows as first -> last."""
+    """Whole blocks end at the newest rollout; a setting changed inside a block shows as first -> last."""
     write_run(tmp_path, [HEADER, "1,10,0,0,100,20,1,0,0,"])
     rows = ["rollout,env_steps,episodes_ended,successes,restarted_episodes,restarted_successes,entropy,"
-            "approx_kl,clip_fraction,lr"]
+            "approx_kl,clip_fraction,lr,entropy_coef"]
     for r in range(1, 8):  # 7 rollouts: blocks of 3 are 1, 2-4, 5-7
         rows.append(f"{r},{4096 * r},{10 + r},{r},4,{r % 3},{1.0 - r / 100},{r / 1000},{r / 100},"
-                    f"{1e-4 if r < 6 else 5e-5}")
+                    f"{1e-4 if r < 6 else 5e-5},{'' if r < 3 else 0.003}")
     (tmp_path / "rollouts.csv").write_text("\n".join(rows) + "\n")
     code, out, err = run(capsys, "status", str(tmp_path), "--rollout-block", "3", "--blocks", "2")
     assert code == 0, err
@@ -81,4 +81,6 @@ def test_status_shows_blocks_of_rollouts_with_update_sizes_and_the_learning_rate
                                f"flag_get {wins}/{starts} ({wins / starts:.1%}) | restarted {rwins}/12 "
                                f"({rwins / 12:.1%}) | entropy {part.entropy.mean():.2f}, "
                                f"approx KL {part.approx_kl.mean():.4f}, clip fraction {part.clip_fraction.mean():.3f}")
-    assert lines[0].endswith("| lr 0.0001") and lines[1].endswith("| lr 0.0001 -> 5e-05")
+    # rollouts 1-2 predate the entropy_coef column (empty): the first block shows the one value it has
+    assert lines[0].endswith("| lr 0.0001, entropy weight 0.003")
+    assert lines[1].endswith("| lr 0.0001 -> 5e-05, entropy weight 0.003")

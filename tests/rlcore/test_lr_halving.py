@@ -64,10 +64,16 @@ def test_ppo_halves_adam_rate_as_the_share_rises_and_a_resume_keeps_it(tmp_path)
     # a resume (after the rate was halved twice) goes on at 2.5e-4, not at --lr's 1e-3
     before = len(rollouts)
     spec.resume = True
-    spec.config = dataclasses.replace(spec.config, max_episodes=len(metrics) + 10, stop_success_share=0.0)
+    first_weight = spec.config.entropy_coef
+    spec.config = dataclasses.replace(spec.config, max_episodes=len(metrics) + 10, stop_success_share=0.0,
+                                      entropy_coef=first_weight + 0.02)  # a resume's --entropy-coef
     ppo_trainer.train(spec)
-    resumed = pd.read_csv(spec.run_dir / "rollouts.csv").iloc[before:]
+    table = pd.read_csv(spec.run_dir / "rollouts.csv")
+    resumed = table.iloc[before:]
     assert len(resumed)
     np.testing.assert_allclose(resumed["lr"], 2.5e-4)
+    # rollouts.csv logs the entropy weight beside the rate, so `main.py status` shows a resume's change
+    np.testing.assert_allclose(table["entropy_coef"].iloc[:before], first_weight)
+    np.testing.assert_allclose(resumed["entropy_coef"], first_weight + 0.02)
     with np.load(spec.run_dir / CHECKPOINT_FILE) as data:
         assert float(data["optimizer/adam/1"]) == pytest.approx(2.5e-4)
