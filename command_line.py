@@ -151,14 +151,14 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
                                         "beside them, and what ended the failures; for a run without a "
                                         "goal (Minitaur), the mean episode length and metres walked; "
                                         "for PPO, per block of rollouts, the same shares beside "
-                                        "the update sizes and learning rate; "
+                                        "the update sizes, learning rate and entropy weight; "
                                         "then the last periodic evaluations.")
     status.add_argument("run_dir", help="a run folder, e.g. long_runs/mario_ppo/2-2")
     status.add_argument("--block", type=COUNT, default=200, help="episodes per block (default 200)")
     status.add_argument("--blocks", type=COUNT, default=6, help="how many of the newest blocks (default 6)")
     status.add_argument("--rollout-block", type=COUNT, default=20,
-                        help="PPO: rollouts per block in the lines that show update sizes and the "
-                             "learning rate (default 20)")
+                        help="PPO: rollouts per block in the lines that show update sizes, the "
+                             "learning rate and the entropy weight (default 20)")
     return parser
 
 

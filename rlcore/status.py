@@ -5,8 +5,8 @@ evaluations start, the success share, the mean progress and the mean return; the
 elsewhere (Mario's restarts) beside them; and what ended the failures. For a run without a goal
 (Minitaur): per block, the mean return, episode length and info keys (metres walked), and the last
 periodic evaluations. For a PPO run, per block of rollouts (``rollouts.csv``): the same success
-shares beside the size of PPO's updates (entropy, approx KL, clip fraction) and the learning rate, to
-see what a change of settings did. It reads the same tables as ``main.py plot`` and works on a run
+shares beside the size of PPO's updates (entropy, approx KL, clip fraction), the learning rate and
+the entropy weight, to see what a change of settings did. It reads the same tables as ``main.py plot`` and works on a run
 that is training, interrupted or finished. TensorFlow-free.
 """
 from __future__ import annotations
@@ -79,7 +79,7 @@ def block_line(experiment, part: pd.DataFrame, partial: pd.DataFrame | None) -> 
 def rollout_lines(rollouts_csv: Path, experiment, block: int, blocks: int) -> list[str]:
     """Per block of ``block`` rollouts (the newest ``blocks``, whole blocks ending at the newest
     rollout): the success share of the episodes from the start, the restarted ones beside it, and PPO's
-    update sizes and learning rate, means per update."""
+    update sizes (means per update), learning rate and entropy weight."""
     if not rollouts_csv.is_file():
         return []
     df = read_table(rollouts_csv, "rollout", "episodes_ended", "successes")
@@ -100,8 +100,8 @@ def _rollout_line(experiment, part: pd.DataFrame) -> str:
     words.append(f"{label} {wins}/{from_start}" + (f" ({wins / from_start:.1%})" if from_start else ""))
     if partial:
         words.append(f"| {key} {int(partial_wins)}/{int(partial)} ({partial_wins / partial:.1%})")
-    sizes = [f"{label} {part[name].mean():.{digits}f}"
-             for name, label, digits in (("entropy", "entropy", 2), ("approx_kl", "approx KL", 4),
+    sizes = [f"{shown} {part[name].mean():.{digits}f}"
+             for name, shown, digits in (("entropy", "entropy", 2), ("approx_kl", "approx KL", 4),
                                          ("clip_fraction", "clip fraction", 3))
              if name in part and part[name].notna().any()]
     if sizes:
