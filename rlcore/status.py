@@ -6,8 +6,8 @@ elsewhere (Mario's restarts) beside them; and what ended the failures. For a run
 (Minitaur): per block, the mean return, episode length and info keys (metres walked), and the last
 periodic evaluations. For a PPO run, per block of rollouts (``rollouts.csv``): the same success
 shares beside the size of PPO's updates (entropy, approx KL, clip fraction), the learning rate and
-the entropy weight, to see what a change of settings did. It reads the same tables as ``main.py plot`` and works on a run
-that is training, interrupted or finished. TensorFlow-free.
+the entropy weight, to see what a change of settings did. It reads the same tables as ``main.py
+plot`` and works on a run that is training, interrupted or finished. TensorFlow-free.
 """
 from __future__ import annotations
 
@@ -31,11 +31,8 @@ def run_status(run_dir: str | Path, experiment, about: dict, block: int = 200,
     recent = full.tail(block * blocks)
     if recent.empty:
         return lines + ["no episode from the start logged yet"]
-    first = len(recent) % block  # whole blocks end at the newest episode; a short first one
-    starts = ([0] if first else []) + list(range(first, len(recent), block))
     span = df[df["episode"] >= recent["episode"].iloc[0]]
-    for begin, end in zip(starts, starts[1:] + [len(recent)]):
-        part = recent.iloc[begin:end]
+    for part in _blocks(recent, block):
         lines.append(block_line(experiment, part, _partial_between(df, experiment, part)))
     causes = cause_line(experiment, span)
     return (lines + ([causes] if causes else []) + rollout_lines(Path(run_dir) / "rollouts.csv", experiment,
@@ -83,11 +80,14 @@ def rollout_lines(rollouts_csv: Path, experiment, block: int, blocks: int) -> li
     if not rollouts_csv.is_file():
         return []
     df = read_table(rollouts_csv, "rollout", "episodes_ended", "successes")
-    recent = df.tail(block * blocks)
-    first = len(recent) % block
-    starts = ([0] if first else []) + list(range(first, len(recent), block))
-    return [_rollout_line(experiment, recent.iloc[begin:end])
-            for begin, end in zip(starts, starts[1:] + [len(recent)])]
+    return [_rollout_line(experiment, part) for part in _blocks(df.tail(block * blocks), block)]
+
+
+def _blocks(rows: pd.DataFrame, block: int) -> list[pd.DataFrame]:
+    """``rows`` cut into blocks of ``block``: whole blocks end at the newest row, a short one first."""
+    first = len(rows) % block
+    starts = ([0] if first else []) + list(range(first, len(rows), block))
+    return [rows.iloc[begin:end] for begin, end in zip(starts, starts[1:] + [len(rows)])]
 
 
 def _rollout_line(experiment, part: pd.DataFrame) -> str:
@@ -106,7 +106,7 @@ def _rollout_line(experiment, part: pd.DataFrame) -> str:
              if name in part and part[name].notna().any()]
     if sizes:
         words.append("| " + ", ".join(sizes))
-    settings = [_setting(part, name, label) for name, label in (("lr", "lr"), ("entropy_coef", "entropy weight"))]
+    settings = [_setting(part, name, shown) for name, shown in (("lr", "lr"), ("entropy_coef", "entropy weight"))]
     if any(settings):
         words.append("| " + ", ".join(text for text in settings if text))
     return " ".join(words)
