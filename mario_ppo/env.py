@@ -205,7 +205,8 @@ def make_env(render_mode: str | None = None, max_episode_steps: int | None = Non
              stage: int = 1, actions: str = "simple", skip: int = 4, score_reward: float = 0.0,
              stall_steps: int = 0, stall_outcome: str = "truncate", frames: str = "skipped",
              dead_ends: bool = False, restart_x: int = 0, restart_every: int = 0,
-             restart_share: float = 0.0, restart_weights: str = "uniform") -> gym.Env:
+             restart_share: float = 0.0, restart_weights: str = "uniform",
+             restart_keep: str = "latest") -> gym.Env:
     """The article's Mario env for one stage. ``max_episode_steps`` counts agent steps (None = none);
     ``score_reward``: reward per game-score point (0 = the article's reward); ``stall_steps``: end
     an episode after this many agent steps without a new best x (0 = never), as a truncation or as a
@@ -213,7 +214,8 @@ def make_env(render_mode: str | None = None, max_episode_steps: int | None = Non
     the last 4 steps ("history", see :class:`SkipAndHistory`); ``dead_ends``: end an episode as a death
     in a known dead end of the level (:data:`DEAD_ENDS`); ``restart_x`` or ``restart_every``,
     ``restart_share``: start that share of episodes where an earlier one passed that x or a multiple
-    of that spacing, the point drawn by ``restart_weights`` (training only, :mod:`mario_ppo.restarts`)."""
+    of that spacing, the point drawn by ``restart_weights``, each point's state kept by ``restart_keep``
+    (training only, :mod:`mario_ppo.restarts`)."""
     import gym_super_mario_bros  # noqa: F401  registers the SuperMarioBros-* ids
     from nes_py.wrappers import JoypadSpace
 
@@ -231,7 +233,8 @@ def make_env(render_mode: str | None = None, max_episode_steps: int | None = Non
     env = gym.make(f"SuperMarioBros-{world}-{stage}-v0", render_mode=render_mode).unwrapped
     env = JoypadSpace(env, action_list(actions))
     if (restart_x or restart_every) and restart_share:
-        env = Restarts(env, restart_share, x=restart_x, every=restart_every, weights=restart_weights)
+        env = Restarts(env, restart_share, x=restart_x, every=restart_every, weights=restart_weights,
+                       keep=restart_keep)
     stack = SkipAndHistory if frames == "history" else SkipAndStack
     env = KilledBy(stack(ArticleShaping(ClassicReward(env, score_reward)), skip))
     if dead_ends:

@@ -12,7 +12,7 @@ from mario_ppo.deaths import cause_name
 from mario_ppo.env import ACTION_SETS, FRAME_STACKS, make_env
 from mario_ppo.episode_ends import StallLimit
 from mario_ppo.levels import STAGE, WORLD
-from mario_ppo.restarts import WEIGHTS
+from mario_ppo.restarts import KEEPS, WEIGHTS
 from rlcore.allowed import OFF_OR_COUNT, Allowed, choices, require
 from rlcore.configs import PPOConfig
 from rlcore.experiment import AlgoSpec, Experiment
@@ -56,6 +56,11 @@ class MarioPPOConfig(PPOConfig):
                 "proportion to 1 + the env's recent failed episodes that ended between that point and "
                 "the next, so the places where the policy dies get the most tries)",
         "allowed": choices(*WEIGHTS)})
+    restart_keep: str = field(default="latest", metadata={
+        "help": "with --restart-x or --restart-every: which state a point keeps: latest (of the last "
+                "episode that passed it, so the points follow the policy), or furthest (of the episode "
+                "that went furthest past it, so the points before a gap hold a crossing's takeoff even "
+                "after the policy has stopped crossing)", "allowed": choices(*KEEPS)})
 
     def __post_init__(self):
         super().__post_init__()
@@ -117,7 +122,7 @@ EXPERIMENT = Experiment(
     video_fps=60,
     env_fields=("world", "stage", "actions", "score_reward", "stall_steps", "stall_outcome",
                 "frames", "dead_ends"),
-    train_env_fields=("restart_x", "restart_every", "restart_share", "restart_weights"),
+    train_env_fields=("restart_x", "restart_every", "restart_share", "restart_weights", "restart_keep"),
     success_key="flag_get", progress_key="x_pos", partial_key="restarted", env_memory="restart_routes",
     info_keys=("stalled", "start_x", "killed_by"), cause_key="killed_by", cause_name=cause_name,
     eval_episodes=10, ship_by=("world", "stage"), default_model="1-1", score_label="return (shaped, /10)",

@@ -20,6 +20,17 @@ quarter of them (95 % of which reached the flag). The failures are counted by th
 episode cut short above it (a stall, a dead end) counts where it stopped; they are not checkpointed,
 so a resumed run draws uniformly until its envs have failed again.
 
+Which state a point keeps (``keep``): the one of the latest episode that passed it ("latest", so the
+points follow the current policy), or the one of the episode that went furthest past it
+("furthest"). The second is for a gap that the policy has stopped crossing. On 1-3, 11 of the first
+~2,100 episodes crossed the gap at x ~800 and none of the next ~25,000 did: the policy had settled on
+dying there, and with "latest" the points before the gap held states from which it dies. With
+"furthest" they keep the states of a crossing (its takeoff, mid-air), so restarts there give the
+policy the end of a jump that works, then more of it as it learns: the backward curriculum of
+learning from one demonstration (Salimans & Chen 2018), the demonstration being the agent's own
+crossing. An episode's reach is the furthest x it reached alive (the flag: past every x); when it
+ends, a state it passed is kept where its reach is at least that of the state kept there.
+
 Evaluation never uses it: both are training-only settings (``Experiment.train_env_fields``), so
 every evaluation and video starts at the level's start. Restarted episodes are marked
 (``info["restarted"]``) and left out of the flag share that the stop rule reads; ``info["start_x"]``
@@ -28,7 +39,10 @@ says where each episode started (metrics.csv: which points are hard).
 A kept point is an emulator state and its route: the buttons, one per NES frame, that lead to it
 from the level's start (through the routes of the restarts it came from). The emulator is
 deterministic, so a checkpoint keeps the routes (``restart_routes``, a few KB each) and a resumed run
-replays them to get its points back; the emulator's own state cannot be written to a file.
+replays them to get its points back; the emulator's own state cannot be written to a file. With
+"furthest", the route a checkpoint keeps for a point is that of its episode up to the episode's reach,
+and a replayed route offers every point it passes with the reach of where it ends: the points and
+reaches come back, even when the spacing or the restart x has changed.
 
 TensorFlow-free: env-pool worker processes import this module.
 """
@@ -41,6 +55,8 @@ import gymnasium as gym
 import numpy as np
 
 WEIGHTS = ("uniform", "deaths")
+KEEPS = ("latest", "furthest")
+FLAG = 10**9  # the reach of an episode that got the flag: past every x
 DEATHS_KEPT = 100  # failed episodes per env that weigh the points: ~30 rollouts of 8 envs on 2-2
 
 
@@ -63,19 +79,28 @@ class Restarts(gym.Wrapper):
     points follow the current policy). From then on, each reset loads one kept state with probability
     ``share``, the point drawn uniformly; both draws come from the env's seeded RNG. The kept states
     live in this env; ``restart_routes`` gets and sets them as routes (a resumed run's pool sets what
-    the checkpoint kept). With ``weights="deaths"`` the point is drawn by :func:`death_weights`.
+    the checkpoint kept). With ``weights="deaths"`` the point is drawn by :func:`death_weights`; with
+    ``keep="furthest"`` a point keeps the state of the episode that went furthest past it instead.
     """
 
-    def __init__(self, env: gym.Env, share: float, x: int = 0, every: int = 0, weights: str = "uniform"):
+    def __init__(self, env: gym.Env, share: float, x: int = 0, every: int = 0, weights: str = "uniform",
+                 keep: str = "latest"):
         super().__init__(env)
         if bool(x) == bool(every):
             raise ValueError("give one of x (a single restart point) and every (a spacing)")
         if weights not in WEIGHTS:
             raise ValueError(f"unknown restart weights {weights!r}; choose one of {', '.join(WEIGHTS)}")
-        self.x, self.every, self.share, self.weights = x, every, share, weights
+        if keep not in KEEPS:
+            raise ValueError(f"unknown restart keep rule {keep!r}; choose one of {', '.join(KEEPS)}")
+        self.x, self.every, self.share, self.weights, self.keep = x, every, share, weights, keep
         self.failures: deque[int] = deque(maxlen=DEATHS_KEPT)  # the point each failed episode ended at
         self._last: dict | None = None  # the info of this episode's last step (None: no step yet)
         self._snapshots: dict[int, tuple[object, bytes]] = {}  # point number -> (emulator state, route)
+        self._reach: dict[int, int] = {}  # point number -> the reach of the episode its state came from
+        self._passed_states: dict[int, tuple[object, bytes]] = {}  # this episode's, for keep="furthest"
+        self._furthest_x = 0  # this episode's reach so far
+        self._furthest_frame = 0  # the length of its route when it got there
+        self._full_routes: dict[int, bytes] = {}  # keep="furthest": point -> its episode's route to its reach
         self._restarted = False
         self._passed = 0
         self._start_x = 0
@@ -90,7 +115,9 @@ class Restarts(gym.Wrapper):
     def reset(self, *, seed=None, options=None):
         if self._last is not None and not self._last.get("flag_get"):
             self.failures.append(self.point(self._last["x_pos"]))
+        self._keep_furthest(self._passed_states, self._furthest_x, bytes(self._route[: self._furthest_frame]))
         self._last = None
+        self._passed_states, self._furthest_x, self._furthest_frame = {}, 0, 0
         obs, info = self.env.reset(seed=seed, options=options)
         self._restarted = bool(self._snapshots) and self.np_random.random() < self.share
         self._route = bytearray()
@@ -115,39 +142,64 @@ class Restarts(gym.Wrapper):
         obs, reward, terminated, truncated, info = self.env.step(action)
         self._route.append(int(action))
         self._last = info
+        alive = not (terminated or truncated or info.get("is_dying"))
         reached = self.point(info["x_pos"])
         if reached > self._passed:
-            if not (terminated or truncated or info.get("is_dying")):
-                self._snapshots[reached] = (self.env.unwrapped.dump_state(), bytes(self._route))
+            if alive:
+                state = (self.env.unwrapped.dump_state(), bytes(self._route))
+                kept = self._snapshots if self.keep == "latest" else self._passed_states  # see reset
+                kept[reached] = state
             self._passed = reached
+        if alive and info["x_pos"] > self._furthest_x:
+            self._furthest_x, self._furthest_frame = int(info["x_pos"]), len(self._route)
+        if info.get("flag_get"):
+            self._furthest_x = FLAG
         info["restarted"], info["start_x"] = self._restarted, self._start_x
         return obs, reward, terminated, truncated, info
 
+    def _keep_furthest(self, passed: dict[int, tuple[object, bytes]], reach: int, full_route: bytes) -> None:
+        """keep="furthest": keep each state of ``passed`` (point -> state, from an episode that
+        reached x ``reach`` alive along ``full_route``) where ``reach`` is at least the kept state's."""
+        for point, state in passed.items():
+            if reach >= self._reach.get(point, -1):
+                self._snapshots[point], self._reach[point] = state, reach
+                self._full_routes[point] = full_route
+
     @property
     def restart_routes(self) -> dict[str, np.ndarray]:
-        """The route (uint8 buttons, one per frame) of each kept point, keyed by its number."""
-        return {str(point): np.frombuffer(route, np.uint8) for point, (_, route) in self._snapshots.items()}
+        """The route (uint8 buttons, one per frame) of each kept point, keyed by its number: to the
+        point, or with keep="furthest" to the reach of the episode the point's state came from."""
+        routes = {point: route for point, (_, route) in self._snapshots.items()}
+        if self.keep == "furthest":
+            routes = self._full_routes
+        return {str(point): np.frombuffer(route, np.uint8) for point, route in routes.items()}
 
     @restart_routes.setter
     def restart_routes(self, routes: dict[str, np.ndarray]) -> None:
-        """Keep the points these routes lead to, replayed from the level's start; a route that does
-        not reach its point alive (from another level or button set) is left out. The env must be
-        reset before its next step."""
-        for key, route in routes.items():
-            route = np.asarray(route, np.uint8)
-            snapshot = self._replay(route, int(key))
-            if snapshot is not None:
-                self._snapshots[int(key)] = (snapshot, route.tobytes())
+        """Keep the points these routes lead to, replayed from the level's start. With keep="latest"
+        each route gives the state at its end, kept at its own point; a route that does not reach that
+        point alive (from another level, button set or spacing) is left out. With "furthest" each
+        route offers every point it passes alive, with the reach of the x where it ends alive.
+        The env must be reset before its next step."""
+        for key, route in sorted(routes.items(), key=lambda item: int(item[0])):
+            passed, end_x = self._replay(np.asarray(route, np.uint8))
+            if self.keep == "furthest":
+                self._keep_furthest(passed, end_x, np.asarray(route, np.uint8).tobytes())
+            elif int(key) in passed and int(key) == max(passed):
+                self._snapshots[int(key)] = passed[int(key)]
 
-    def _replay(self, route: np.ndarray, point: int):
-        """The emulator state at the end of ``route`` from the level's start, if it is at ``point``
-        and alive; else None."""
+    def _replay(self, route: np.ndarray) -> tuple[dict[int, tuple[object, bytes]], int]:
+        """The state and route at each point that ``route``, played from the level's start, passes
+        alive, and the x where it ends (nothing if it dies or ends before its last frame)."""
         self.env.reset()
         info = {"x_pos": -1}
-        for action in route:
+        passed, furthest = {}, 0
+        for frame, action in enumerate(route):
             _, _, terminated, truncated, info = self.env.step(int(action))
             if terminated or truncated:
-                return None
-        if self.point(info["x_pos"]) != point or info.get("is_dying"):
-            return None
-        return self.env.unwrapped.dump_state()
+                return {}, 0
+            point = self.point(info["x_pos"])
+            if point > furthest and not info.get("is_dying"):
+                passed[point] = (self.env.unwrapped.dump_state(), route[: frame + 1].tobytes())
+                furthest = point
+        return ({}, 0) if info.get("is_dying") else (passed, int(info["x_pos"]))
