@@ -128,7 +128,8 @@ class SkipAndStack(gym.Wrapper):
     """Repeat each action for ``skip`` frames; observe those frames (gray 84x84) as channels.
 
     Rewards of the skipped frames are summed. If the episode ends early, the last frame fills the
-    remaining channels. Reset shows the first frame ``skip`` times. ``info`` is trimmed to
+    remaining channels. Reset shows the first frame ``skip`` times, or for a restart (below) the last
+    ``skip`` frames it played in (``info["warmup_frames"]``). ``info`` is trimmed to
     :data:`INFO_KEYS` (less to send over the pool's Pipes). With ``render_mode="rgb_array"``, every
     emulator frame of the last step is kept in ``self.frames`` for a full-rate video.
     """
@@ -147,7 +148,13 @@ class SkipAndStack(gym.Wrapper):
         frame, info = self.env.reset(seed=seed, options=options)
         self.frames = []
         self._keep(frame)
-        return np.repeat(gray_84(frame)[:, :, None], self.skip, axis=2), _trim(info)
+        return self._first_obs(frame, info.get("warmup_frames", [])), _trim(info)
+
+    def _first_obs(self, frame, warmup: list) -> np.ndarray:
+        """The 4 frames of the step that ended in ``frame``: the last frames of ``warmup``, else
+        ``frame`` repeated."""
+        grays = [gray_84(f) for f in warmup[-self.skip:]] or [gray_84(frame)]
+        return np.stack([grays[0]] * (self.skip - len(grays)) + grays, axis=2)
 
     def step(self, action):
         obs = np.empty((FRAME_SIZE, FRAME_SIZE, self.skip), np.uint8)
@@ -173,12 +180,21 @@ class SkipAndHistory(SkipAndStack):
     which does not jump again until released) looks different from one that has just landed, so a
     policy can act differently in the two. Only the pooled half of each step is converted to gray.
     If the episode ends before the pooled half, the last frame is the step's channel. Reset shows
-    the first frame ``skip`` times.
+    the first frame ``skip`` times, or for a restart the steps it played in (``info["warmup_frames"]``,
+    cut into steps of ``skip`` frames that end at its last frame).
     """
 
     def reset(self, *, seed=None, options=None):
         self._stack, info = super().reset(seed=seed, options=options)
         return self._stack, info
+
+    def _first_obs(self, frame, warmup: list) -> np.ndarray:
+        steps = [warmup[max(0, end - self.skip):end] for end in range(len(warmup), 0, -self.skip)][::-1]
+        pooled = [np.max([gray_84(f) for f in step[self.skip // 2:] or step[-1:]], axis=0)
+                  for step in steps[-self.skip:]]
+        if not pooled:
+            pooled = [gray_84(frame)]
+        return np.stack([pooled[0]] * (self.skip - len(pooled)) + pooled, axis=2)
 
     def step(self, action):
         total, terminated, truncated = 0.0, False, False
