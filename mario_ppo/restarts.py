@@ -47,8 +47,9 @@ reaches come back, even when the spacing or the restart x has changed.
 A restart does not load the point's own state but the state :data:`WARMUP` frames before it, and
 replays the route's last frames from there: the frames it shows (``info["warmup_frames"]``) let the
 frame stack above start as it was in the episode that passed the point, not as one frame four times.
-Mid-jump, that is the difference between a Mario seen rising and one hanging still: from the states
-of 1-3's old crossings the policy crossed in 6-8 of 8 tries from x 630 and in none from x 620.
+Mid-jump, that is the difference between a Mario seen rising and one hanging still (from the states
+of 1-3's old crossings, before the warm-up, the policy crossed in up to 8 of 8 tries from x 630 and in
+0-1 of 8 from x 620, a few frames earlier in the same jumps).
 
 TensorFlow-free: env-pool worker processes import this module.
 """
