@@ -1,10 +1,12 @@
 """Probe (twenty-first session): from the states of 1-3's old gap crossings, how often does the
 checkpoint's policy, sampling from pi, cross the gap at x ~800?
 
-The checkpoint keeps, for 4 of its 8 envs, routes from the level's start past x 900 (points 3 and 4
-of the 300 spacing): the crossings of the first ~2,100 episodes. Each is replayed with
-``keep="furthest"`` on a 10 spacing, which gives the route's own state at every 10 x; from a few of
-them, 8 episodes each are played until they pass x 880 or end. Run from the repo root:
+The checkpoint keeps, in envs 0, 1, 4 and 7, routes from the level's start past x 900: the crossings
+of the first ~2,100 episodes (env 2's is one of its own episodes, which fell). Each is replayed
+with ``keep="furthest"`` on a 10 spacing, which gives the route's own state at every 10 x; from a
+few of them, 8 episodes each are played until they pass x 880 or end. (Run at rollout 257, the
+checkpoint kept them under the 300 spacing's points 3 and 4 and the filter was on those keys; from
+rollout 258 they are kept under "1", the point of ``--restart-x 630``.) Run from the repo root:
 
     python long_runs/mario_ppo/1-3/probe_crossings.py
 """
@@ -20,9 +22,10 @@ from rlcore.snapshot import model_from_checkpoint
 
 RUN = Path("long_runs/mario_ppo/1-3")
 POINTS, TRIES, PAST = (59, 60, 61, 62, 63, 64), 8, 880
+ENVS = ("0", "1", "2", "4", "7")
 
 z = np.load(RUN / "checkpoint.npz")
-routes = {k: z[k] for k in z.files if k.startswith("array/env/") and k.split("/")[3] in ("3", "4")}
+routes = {k: z[k] for k in z.files if k.startswith("array/env/") and k.split("/")[2] in ENVS}
 with tempfile.TemporaryDirectory() as tmp:
     model_from_checkpoint(RUN, tmp, "mario_ppo", "ppo")
     _, _, policy = load_policy(tmp)
