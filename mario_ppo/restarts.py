@@ -44,9 +44,10 @@ replays them to get its points back; the emulator's own state cannot be written 
 and a replayed route offers every point it passes with the reach of where it ends: the points and
 reaches come back, even when the spacing or the restart x has changed.
 
-A restart does not load the point's own state but the state :data:`WARMUP` frames before it, and
-replays the route's last frames from there: the frames it shows (``info["warmup_frames"]``) let the
-frame stack above start as it was in the episode that passed the point, not as one frame four times.
+A restart does not load the point's own state but one 16-19 frames before it (a state is kept every
+:data:`DUMP_EVERY` frames, not every frame: a dump costs ~2 % of a frame), and replays the route from
+there: the last :data:`WARMUP` frames it shows (``info["warmup_frames"]``) let the frame stack above
+start as it was in the episode that passed the point, not as one frame four times.
 Mid-jump, that is the difference between a Mario seen rising and one hanging still (from the states
 of 1-3's old crossings, before the warm-up, the policy crossed in up to 8 of 8 tries from x 630 and in
 0-1 of 8 from x 620, a few frames earlier in the same jumps).
@@ -65,7 +66,8 @@ import numpy as np
 WEIGHTS = ("uniform", "deaths")
 KEEPS = ("latest", "furthest")
 FLAG = 10**9  # the reach of an episode that got the flag: past every x
-WARMUP = 16  # frames replayed into a restart: 4 agent steps of 4 frames, what the frame stacks show
+WARMUP = 16  # frames shown from a restart's replay: 4 agent steps of 4 frames, what the frame stacks show
+DUMP_EVERY = 4  # frames between the states kept for a warm-up (a dump costs ~2 % of a frame)
 DEATHS_KEPT = 100  # failed episodes per env that weigh the points: ~30 rollouts of 8 envs on 2-2
 
 
@@ -75,6 +77,11 @@ class Kept(NamedTuple):
     earlier: object
     route: bytes
     warmup: int
+
+
+def _recent_states(*first: tuple[object, int]) -> deque:
+    """Room for the (state, route length) pairs of the last WARMUP + DUMP_EVERY frames."""
+    return deque(first, maxlen=WARMUP // DUMP_EVERY + 2)
 
 
 def death_weights(points: list[int], failures: Iterable[int]) -> np.ndarray:
@@ -113,7 +120,7 @@ class Restarts(gym.Wrapper):
         self.failures: deque[int] = deque(maxlen=DEATHS_KEPT)  # the point each failed episode ended at
         self._last: dict | None = None  # the info of this episode's last step (None: no step yet)
         self._snapshots: dict[int, Kept] = {}  # point number -> how to start there
-        self._recent: deque[tuple[object, int]] = deque(maxlen=WARMUP + 1)  # (state, route length) per frame
+        self._recent = _recent_states()  # (state, route length) every DUMP_EVERY frames
         self._reach: dict[int, int] = {}  # point number -> the reach of the episode its state came from
         self._passed_states: dict[int, Kept] = {}  # this episode's, for keep="furthest"
         self._furthest_x = 0  # this episode's reach so far
@@ -148,14 +155,13 @@ class Restarts(gym.Wrapper):
             obs, info = self._load(self._snapshots[points[pick]])
         self._passed = self.point(info["x_pos"])
         self._start_x = int(info["x_pos"])
-        self._recent.clear()
-        self._recent.append((self.env.unwrapped.dump_state(), len(self._route)))
+        self._recent = _recent_states((self.env.unwrapped.dump_state(), len(self._route)))
         info["restarted"], info["start_x"] = self._restarted, self._start_x
         return obs, info
 
     def _load(self, kept: Kept):
         """Start at ``kept``'s point: load its earlier state and play the route's last frames; the
-        last screen and info, with every screen played in ``info["warmup_frames"]``."""
+        last screen and info, with the last WARMUP screens played in ``info["warmup_frames"]``."""
         base = self.env.unwrapped
         base.load_state(kept.earlier)
         base._did_reset()  # the env's own "last" counters (time, x, score) from the loaded state
@@ -164,18 +170,21 @@ class Restarts(gym.Wrapper):
             obs, _, _, _, info = self.env.step(action)
             frames.append(np.array(obs))
         self._route = bytearray(kept.route)
-        info["warmup_frames"] = frames
+        info["warmup_frames"] = frames[-WARMUP:]
         return obs, info
 
-    def _kept(self, recent: deque, route: bytes) -> Kept:
-        """The point just passed at the end of ``route``, from the oldest of the ``recent`` states."""
-        earlier, length = recent[0]
+    @staticmethod
+    def _kept(recent: deque, route: bytes) -> Kept:
+        """The point just passed at the end of ``route``, from the newest of the ``recent`` states at
+        least WARMUP frames before it (else the oldest)."""
+        earlier, length = next((s for s in reversed(recent) if len(route) - s[1] >= WARMUP), recent[0])
         return Kept(earlier, route, len(route) - length)
 
     def step(self, action):
         obs, reward, terminated, truncated, info = self.env.step(action)
         self._route.append(int(action))
-        self._recent.append((self.env.unwrapped.dump_state(), len(self._route)))
+        if len(self._route) - self._recent[-1][1] >= DUMP_EVERY:
+            self._recent.append((self.env.unwrapped.dump_state(), len(self._route)))
         self._last = info
         alive = not (terminated or truncated or info.get("is_dying"))
         reached = self.point(info["x_pos"])
@@ -204,9 +213,8 @@ class Restarts(gym.Wrapper):
     def restart_routes(self) -> dict[str, np.ndarray]:
         """The route (uint8 buttons, one per frame) of each kept point, keyed by its number: to the
         point, or with keep="furthest" to the reach of the episode the point's state came from."""
-        routes = {point: kept.route for point, kept in self._snapshots.items()}
-        if self.keep == "furthest":
-            routes = self._full_routes
+        routes = (self._full_routes if self.keep == "furthest"
+                  else {point: kept.route for point, kept in self._snapshots.items()})
         return {str(point): np.frombuffer(route, np.uint8) for point, route in routes.items()}
 
     @restart_routes.setter
@@ -217,9 +225,10 @@ class Restarts(gym.Wrapper):
         route offers every point it passes alive, with the reach of the x where it ends alive.
         The env must be reset before its next step."""
         for key, route in sorted(routes.items(), key=lambda item: int(item[0])):
-            passed, end_x = self._replay(np.asarray(route, np.uint8))
+            route = np.asarray(route, np.uint8)
+            passed, end_x = self._replay(route)
             if self.keep == "furthest":
-                self._keep_furthest(passed, end_x, np.asarray(route, np.uint8).tobytes())
+                self._keep_furthest(passed, end_x, route.tobytes())
             elif int(key) in passed and int(key) == max(passed):
                 self._snapshots[int(key)] = passed[int(key)]
 
@@ -227,12 +236,13 @@ class Restarts(gym.Wrapper):
         """How to start at each point that ``route``, played from the level's start, passes alive,
         and the x where it ends (nothing if it dies or ends before its last frame)."""
         self.env.reset()
-        recent = deque([(self.env.unwrapped.dump_state(), 0)], maxlen=WARMUP + 1)
+        recent = _recent_states((self.env.unwrapped.dump_state(), 0))
         info = {"x_pos": -1}
         passed, furthest = {}, 0
         for frame, action in enumerate(route):
             _, _, terminated, truncated, info = self.env.step(int(action))
-            recent.append((self.env.unwrapped.dump_state(), frame + 1))
+            if (frame + 1) % DUMP_EVERY == 0:
+                recent.append((self.env.unwrapped.dump_state(), frame + 1))
             if terminated or truncated:
                 return {}, 0
             point = self.point(info["x_pos"])
