@@ -222,7 +222,8 @@ def make_env(render_mode: str | None = None, max_episode_steps: int | None = Non
              stall_steps: int = 0, stall_outcome: str = "truncate", frames: str = "skipped",
              dead_ends: bool = False, restart_x: int = 0, restart_every: int = 0,
              restart_share: float = 0.0, restart_weights: str = "uniform",
-             restart_keep: str = "latest") -> gym.Env:
+             restart_keep: str = "latest", restart_back_step: int = 0, restart_goal_x: int = 0,
+             restart_back_share: float = 0.5) -> gym.Env:
     """The article's Mario env for one stage. ``max_episode_steps`` counts agent steps (None = none);
     ``score_reward``: reward per game-score point (0 = the article's reward); ``stall_steps``: end
     an episode after this many agent steps without a new best x (0 = never), as a truncation or as a
@@ -230,8 +231,9 @@ def make_env(render_mode: str | None = None, max_episode_steps: int | None = Non
     the last 4 steps ("history", see :class:`SkipAndHistory`); ``dead_ends``: end an episode as a death
     in a known dead end of the level (:data:`DEAD_ENDS`); ``restart_x`` or ``restart_every``,
     ``restart_share``: start that share of episodes where an earlier one passed that x or a multiple
-    of that spacing, the point drawn by ``restart_weights``, each point's state kept by ``restart_keep``
-    (training only, :mod:`mario_ppo.restarts`)."""
+    of that spacing, the point drawn by ``restart_weights``, each point's state kept by ``restart_keep``,
+    the x stepped back by ``restart_back_step`` once ``restart_back_share`` of the restarts get past
+    ``restart_goal_x`` (training only, :mod:`mario_ppo.restarts`)."""
     import gym_super_mario_bros  # noqa: F401  registers the SuperMarioBros-* ids
     from nes_py.wrappers import JoypadSpace
 
@@ -250,7 +252,8 @@ def make_env(render_mode: str | None = None, max_episode_steps: int | None = Non
     env = JoypadSpace(env, action_list(actions))
     if (restart_x or restart_every) and restart_share:
         env = Restarts(env, restart_share, x=restart_x, every=restart_every, weights=restart_weights,
-                       keep=restart_keep)
+                       keep=restart_keep, back_step=restart_back_step, goal_x=restart_goal_x,
+                       back_share=restart_back_share)
     stack = SkipAndHistory if frames == "history" else SkipAndStack
     env = KilledBy(stack(ArticleShaping(ClassicReward(env, score_reward)), skip))
     if dead_ends:

@@ -61,11 +61,24 @@ class MarioPPOConfig(PPOConfig):
                 "episode that passed it, so the points follow the policy), or furthest (of the episode "
                 "that went furthest past it, so the points before a gap hold a crossing's takeoff even "
                 "after the policy has stopped crossing)", "allowed": choices(*KEEPS)})
+    restart_back_step: int = field(default=0, metadata={
+        "help": "with --restart-x: step each env's restart x back by this many x whenever its restarted "
+                "episodes got past --restart-goal-x in at least --restart-back-share of its last 40, "
+                "a backward curriculum by rule (0 = off: the x stays)", "allowed": OFF_OR_COUNT})
+    restart_goal_x: int = field(default=0, metadata={
+        "help": "with --restart-back-step: the x past which a restarted episode counts as a success "
+                "(past the hard place, e.g. 850 on 1-3)", "allowed": OFF_OR_COUNT})
+    restart_back_share: float = field(default=0.5, metadata={
+        "help": "with --restart-back-step: the share of an env's last 40 restarted episodes that must "
+                "get past --restart-goal-x before its x steps back",
+        "allowed": Allowed(low=0, high=1, low_open=True)})
 
     def __post_init__(self):
         super().__post_init__()
         require(not (self.restart_x and self.restart_every),
                 "--restart-x and --restart-every are two ways to say where restarts start: give one")
+        require(not self.restart_back_step or self.restart_goal_x > self.restart_x > 0,
+                "--restart-back-step needs --restart-x and a --restart-goal-x past it")
 
 
 # Article 001: 8 envs x 512 steps, GAE gamma 0.99 lambda 0.97, clip 0.2, entropy 0.05, Adam 1e-4,
@@ -122,7 +135,8 @@ EXPERIMENT = Experiment(
     video_fps=60,
     env_fields=("world", "stage", "actions", "score_reward", "stall_steps", "stall_outcome",
                 "frames", "dead_ends"),
-    train_env_fields=("restart_x", "restart_every", "restart_share", "restart_weights", "restart_keep"),
+    train_env_fields=("restart_x", "restart_every", "restart_share", "restart_weights", "restart_keep",
+                      "restart_back_step", "restart_goal_x", "restart_back_share"),
     success_key="flag_get", progress_key="x_pos", partial_key="restarted", env_memory="restart_routes",
     info_keys=("stalled", "start_x", "killed_by"), cause_key="killed_by", cause_name=cause_name,
     eval_episodes=10, ship_by=("world", "stage"), default_model="1-1", score_label="return (shaped, /10)",

@@ -31,6 +31,14 @@ learning from one demonstration (Salimans & Chen 2018), the demonstration being 
 crossing. An episode's reach is the furthest x it reached alive (the flag: past every x); when it
 ends, a state it passed is kept where its reach is at least that of the state kept there.
 
+A restart x can also step itself back (``back_step``): each time this env's restarted episodes got
+past ``goal_x`` alive in at least ``back_share`` of its last :data:`BACK_WINDOW`, the x moves
+``back_step`` closer to the start, and the point's state is found again by replaying the route it
+came from. That is the backward curriculum of Salimans & Chen (2018) run by rule: on 1-3, stepped
+by hand from x 630 to 600, each 10 x took 15-90 rollouts, whatever the hour. Each env steps on its
+own (on 1-3 only half the envs held a crossing at all), ``info["start_x"]`` shows where, and a
+checkpoint keeps each env's x with its routes.
+
 Evaluation never uses it: both are training-only settings (``Experiment.train_env_fields``), so
 every evaluation and video starts at the level's start. Restarted episodes are marked
 (``info["restarted"]``) and left out of the flag share that the stop rule reads; ``info["start_x"]``
@@ -69,6 +77,8 @@ FLAG = 10**9  # the reach of an episode that got the flag: past every x
 WARMUP = 16  # frames shown from a restart's replay: 4 agent steps of 4 frames, what the frame stacks show
 DUMP_EVERY = 4  # frames between the states kept for a warm-up (a dump costs ~2 % of a frame)
 DEATHS_KEPT = 100  # failed episodes per env that weigh the points: ~30 rollouts of 8 envs on 2-2
+BACK_WINDOW = 40  # restarted episodes per env that decide a step back: ~6 rollouts of 8 envs on 1-3
+X_KEY = "x"  # with back_step, the restart_routes entry that holds the env's stepped x
 
 
 class Kept(NamedTuple):
@@ -105,18 +115,24 @@ class Restarts(gym.Wrapper):
     live in this env; ``restart_routes`` gets and sets them as routes (a resumed run's pool sets what
     the checkpoint kept). With ``weights="deaths"`` the point is drawn by :func:`death_weights`; with
     ``keep="furthest"`` a point keeps the state of the episode that went furthest past it instead.
+    With ``back_step``, ``x`` steps back by rule (see the module's docstring).
     """
 
     def __init__(self, env: gym.Env, share: float, x: int = 0, every: int = 0, weights: str = "uniform",
-                 keep: str = "latest"):
+                 keep: str = "latest", back_step: int = 0, goal_x: int = 0, back_share: float = 0.5,
+                 back_window: int = BACK_WINDOW):
         super().__init__(env)
         if bool(x) == bool(every):
             raise ValueError("give one of x (a single restart point) and every (a spacing)")
+        if back_step and not (x and goal_x > x):
+            raise ValueError("a restart x steps back only from a single x (x) towards a goal past it (goal_x > x)")
         if weights not in WEIGHTS:
             raise ValueError(f"unknown restart weights {weights!r}; choose one of {', '.join(WEIGHTS)}")
         if keep not in KEEPS:
             raise ValueError(f"unknown restart keep rule {keep!r}; choose one of {', '.join(KEEPS)}")
         self.x, self.every, self.share, self.weights, self.keep = x, every, share, weights, keep
+        self.back_step, self.goal_x, self.back_share = back_step, goal_x, back_share
+        self.outcomes: deque[bool] = deque(maxlen=back_window)  # restarted episodes: got past goal_x?
         self.failures: deque[int] = deque(maxlen=DEATHS_KEPT)  # the point each failed episode ended at
         self._last: dict | None = None  # the info of this episode's last step (None: no step yet)
         self._snapshots: dict[int, Kept] = {}  # point number -> how to start there
@@ -141,6 +157,8 @@ class Restarts(gym.Wrapper):
         if self._last is not None and not self._last.get("flag_get"):
             self.failures.append(self.point(self._last["x_pos"]))
         self._keep_furthest(self._passed_states, self._furthest_x, bytes(self._route[: self._furthest_frame]))
+        if self.back_step and self._restarted and self._last is not None:
+            self._judge_restart(self._furthest_x >= self.goal_x)
         self._last = None
         self._passed_states, self._furthest_x, self._furthest_frame = {}, 0, 0
         obs, info = self.env.reset(seed=seed, options=options)
@@ -172,6 +190,24 @@ class Restarts(gym.Wrapper):
         self._route = bytearray(kept.route)
         info["warmup_frames"] = frames[-WARMUP:]
         return obs, info
+
+    def _judge_restart(self, got_past: bool) -> None:
+        """Count a restarted episode's outcome; step the x back when enough of the last ones got past
+        the goal, and the step leaves an x past the level's start."""
+        self.outcomes.append(got_past)
+        full = len(self.outcomes) == self.outcomes.maxlen
+        if full and np.mean(self.outcomes) >= self.back_share and self.x > self.back_step:
+            self._move_to(self.x - self.back_step)
+
+    def _move_to(self, x: int) -> None:
+        """Restart from ``x`` (behind the current x): its state comes from replaying the kept route,
+        which passes it. The env must be reset before its next step."""
+        routes = self.restart_routes
+        routes.pop(X_KEY, None)
+        self.x = x
+        self._snapshots, self._reach, self._full_routes = {}, {}, {}  # a flag's reach would outrank its replay's
+        self.outcomes.clear()
+        self.restart_routes = routes
 
     @staticmethod
     def _kept(recent: deque, route: bytes) -> Kept:
@@ -215,15 +251,23 @@ class Restarts(gym.Wrapper):
         point, or with keep="furthest" to the reach of the episode the point's state came from."""
         routes = (self._full_routes if self.keep == "furthest"
                   else {point: kept.route for point, kept in self._snapshots.items()})
-        return {str(point): np.frombuffer(route, np.uint8) for point, route in routes.items()}
+        kept = {str(point): np.frombuffer(route, np.uint8) for point, route in routes.items()}
+        if self.back_step:
+            kept[X_KEY] = np.array([self.x], np.int64)
+        return kept
 
     @restart_routes.setter
     def restart_routes(self, routes: dict[str, np.ndarray]) -> None:
         """Keep the points these routes lead to, replayed from the level's start. With keep="latest"
         each route gives the state at its end, kept at its own point; a route that does not reach that
         point alive (from another level, button set or spacing) is left out. With "furthest" each
-        route offers every point it passes alive, with the reach of the x where it ends alive.
+        route offers every point it passes alive, with the reach of the x where it ends alive. With
+        back_step, the env's stepped x comes back first (never past the x it was built with).
         The env must be reset before its next step."""
+        routes = dict(routes)
+        stepped = routes.pop(X_KEY, None)
+        if self.back_step and stepped is not None:
+            self.x = min(self.x, int(np.asarray(stepped).ravel()[0]))
         for key, route in sorted(routes.items(), key=lambda item: int(item[0])):
             route = np.asarray(route, np.uint8)
             passed, end_x = self._replay(route)

@@ -1,0 +1,100 @@
+"""A restart x that steps itself back (``--restart-back-step``), on the real emulator (1-1, running right).
+
+Running right alone on 1-1 passes x 240 before the first Goomba, so every episode here gets past
+GOAL unless it is cut short.
+"""
+import dataclasses
+from collections import deque
+
+import pytest
+
+from mario_ppo.env import make_env
+from mario_ppo.experiment import EXPERIMENT
+from mario_ppo.restarts import X_KEY
+from rlcore.errors import UserError
+from tests.mario_ppo.test_restarts import _restarts, _run_right_past
+
+X, GOAL, STEP, WINDOW = 160, 230, 40, 3
+
+
+def _stepping_env(x=X, keep="furthest"):
+    env = make_env(restart_x=x, restart_share=1.0, restart_keep=keep, restart_back_step=STEP,
+                   restart_goal_x=GOAL)
+    _restarts(env).outcomes = deque(maxlen=WINDOW)  # decide on 3 restarted episodes, not 40
+    return env
+
+
+def _restarted_episodes(env, reach_x, count, seed):
+    """From a reset, play ``count`` restarted episodes, each running right until ``reach_x``; the
+    start x of each, and the info of the reset after the last."""
+    info, starts = env.reset(seed=seed)[1], []
+    for _ in range(count):
+        assert info["restarted"]
+        starts.append(info["start_x"])
+        _run_right_past(env, reach_x)
+        info = env.reset()[1]
+    return starts, info
+
+
+@pytest.mark.parametrize("keep", ["furthest", "latest"])
+def test_the_x_steps_back_once_the_window_of_restarts_got_past_the_goal(keep):
+    env = _stepping_env(keep=keep)
+    try:
+        env.reset(seed=0)
+        _run_right_past(env, GOAL + 5)  # a first episode from the start passes x and the goal
+        starts, info = _restarted_episodes(env, GOAL, WINDOW, seed=1)
+        assert all(X <= s < X + 10 for s in starts)  # three restarts from x 160, all past the goal
+        assert _restarts(env).x == X - STEP
+        assert info["restarted"] and X - STEP <= info["start_x"] < X - STEP + 10
+        assert len(_restarts(env).outcomes) == 0  # the new x is judged on its own restarts
+    finally:
+        env.close()
+
+
+def test_the_x_stays_while_the_restarts_fall_short_of_the_goal():
+    env = _stepping_env()
+    try:
+        env.reset(seed=0)
+        _run_right_past(env, GOAL + 5)
+        starts, info = _restarted_episodes(env, GOAL - 40, 2 * WINDOW, seed=1)
+        assert _restarts(env).x == X and X <= info["start_x"] < X + 10
+        assert list(_restarts(env).outcomes) == [False] * WINDOW
+    finally:
+        env.close()
+
+
+def test_a_checkpoint_keeps_each_envs_stepped_x():
+    first = _stepping_env()
+    try:
+        first.reset(seed=0)
+        _run_right_past(first, GOAL + 5)
+        _restarted_episodes(first, GOAL, WINDOW, seed=1)
+        routes = first.get_wrapper_attr("restart_routes")
+    finally:
+        first.close()
+    assert int(routes[X_KEY][0]) == X - STEP
+    for built_with, expected in ((X, X - STEP), (X - 2 * STEP, X - 2 * STEP)):
+        second = _stepping_env(x=built_with)
+        try:
+            second.set_wrapper_attr("restart_routes", routes)
+            info = second.reset(seed=5)[1]
+            assert _restarts(second).x == expected  # never past the x the resumed run gives
+            assert info["restarted"] and expected <= info["start_x"] < expected + 10
+        finally:
+            second.close()
+    plain = make_env(restart_x=X, restart_share=1.0, restart_keep="furthest")
+    try:
+        plain.set_wrapper_attr("restart_routes", routes)  # without stepping, the kept x is ignored
+        assert _restarts(plain).x == X and X_KEY not in plain.get_wrapper_attr("restart_routes")
+    finally:
+        plain.close()
+
+
+def test_stepping_back_needs_one_restart_x_and_a_goal_past_it():
+    default = EXPERIMENT.preset("ppo", "default")
+    for fields in (dict(restart_back_step=STEP, restart_goal_x=GOAL),
+                   dict(restart_back_step=STEP, restart_x=X),
+                   dict(restart_back_step=STEP, restart_x=X, restart_goal_x=X)):
+        with pytest.raises(UserError, match="--restart-back-step needs"):
+            dataclasses.replace(default, **fields)
+    dataclasses.replace(default, restart_back_step=STEP, restart_x=X, restart_goal_x=GOAL)
