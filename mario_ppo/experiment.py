@@ -137,7 +137,8 @@ EXPERIMENT = Experiment(
                 "frames", "dead_ends"),
     train_env_fields=("restart_x", "restart_every", "restart_share", "restart_weights", "restart_keep",
                       "restart_back_step", "restart_goal_x", "restart_back_share"),
-    success_key="flag_get", progress_key="x_pos", partial_key="restarted", env_memory="restart_routes",
+    success_key="flag_get", progress_key="x_pos", partial_key="restarted", partial_start_key="start_x",
+    env_memory="restart_routes",
     info_keys=("stalled", "start_x", "killed_by"), cause_key="killed_by", cause_name=cause_name,
     eval_episodes=10, ship_by=("world", "stage"), default_model="1-1", score_label="return (shaped, /10)",
 )

@@ -65,6 +65,7 @@ class Experiment:
     # an info key that marks an episode that did not start where evaluation starts (Mario: restarted):
     # it trains like any other, but its success is left out of the success share the stop rule reads
     partial_key: str | None = None
+    partial_start_key: str | None = None  # an info key: where a partial episode started (Mario: start_x)
     # an attribute of the training env that it builds up over episodes, a dict of name -> array, which
     # a checkpoint keeps and a resumed run's env pool gets back (Mario: restart_routes, the buttons that
     # lead to each kept restart point); ignored when the env has no such attribute

@@ -2,7 +2,7 @@
 
 For a run that lasts many sessions (a Mario level): per block of episodes that started where
 evaluations start, the success share, the mean progress and the mean return; the episodes that started
-elsewhere (Mario's restarts) beside them; and what ended the failures. For a run without a goal
+elsewhere (Mario's restarts) beside them, with where they started; and what ended the failures. For a run without a goal
 (Minitaur): per block, the mean return, episode length and info keys (metres walked), and the last
 periodic evaluations. For a PPO run, per block of rollouts (``rollouts.csv``): the same success
 shares beside the size of PPO's updates (entropy, approx KL, clip fraction), the learning rate and
@@ -70,7 +70,18 @@ def block_line(experiment, part: pd.DataFrame, partial: pd.DataFrame | None) -> 
     if partial is not None and len(partial):
         wins = f" ({int(partial['success'].sum())} {experiment.success_key})" if "success" in partial else ""
         words.append(f"| {experiment.partial_key} {len(partial)}{wins}")
+        words += _starts(experiment, partial)
     return " ".join(words)
+
+
+def _starts(experiment, partial: pd.DataFrame) -> list[str]:
+    """Where the partial episodes started (``Experiment.partial_start_key``, Mario's ``start_x``: a
+    restart x stepping back shows)."""
+    column = experiment.partial_start_key
+    if not column or column not in partial or partial[column].isna().all():
+        return []
+    low, high = partial[column].min(), partial[column].max()
+    return [f"from {column} {low:,.0f}" + (f"-{high:,.0f}" if high > low else "")]
 
 
 def rollout_lines(rollouts_csv: Path, experiment, block: int, blocks: int) -> list[str]:

@@ -40,6 +40,19 @@ def test_status_counts_flags_per_block_of_full_episodes_and_restarts_beside_them
     assert len(lines) == 4
 
 
+def test_status_says_where_the_restarted_episodes_of_a_block_started(capsys, tmp_path):
+    rows = [HEADER + ",start_x"]
+    for i in range(1, 21):  # odd episodes restarted, from x 600 in the first block, 590-600 in the second
+        start = 40 if i % 2 == 0 else (600 if i < 11 else 590 + (i % 4 == 1) * 10)
+        rows.append(f"{i},{10 * i},0,0,{100 * i},{700 + i},0,0,{i % 2},-1,{start}")
+    write_run(tmp_path, rows)
+    code, out, err = run(capsys, "status", str(tmp_path), "--block", "5", "--blocks", "2")
+    assert code == 0, err
+    first, second = out.splitlines()[1:3]
+    assert first.endswith("| restarted 4 (0 flag_get) from start_x 600")
+    assert second.endswith("| restarted 4 (0 flag_get) from start_x 590-600")
+
+
 def test_status_of_a_shipped_level_reads_its_meta_and_ends_at_its_last_episode(capsys):
     folder = ROOT / "saved_networks" / "mario_ppo" / "1-4"
     code, out, err = run(capsys, "status", str(folder), "--block", "100", "--blocks", "1")
