@@ -193,7 +193,7 @@ class Restarts(gym.Wrapper):
 
     def _judge_restart(self, got_past: bool) -> None:
         """Count a restarted episode's outcome; step the x back when enough of the last ones got past
-        the goal, and the step leaves an x past the level's start."""
+        the goal (while the x stays above 0; behind the level's start, restarts start there)."""
         self.outcomes.append(got_past)
         full = len(self.outcomes) == self.outcomes.maxlen
         if full and np.mean(self.outcomes) >= self.back_share and self.x > self.back_step:
