@@ -12,7 +12,7 @@ from mario_ppo.deaths import cause_name
 from mario_ppo.env import ACTION_SETS, FRAME_STACKS, make_env
 from mario_ppo.episode_ends import StallLimit
 from mario_ppo.levels import STAGE, WORLD
-from mario_ppo.restarts import KEEPS, WEIGHTS
+from mario_ppo.restarts import KEEPS, WEIGHTS, lend_routes
 from rlcore.allowed import OFF_OR_COUNT, Allowed, choices, require
 from rlcore.configs import PPOConfig
 from rlcore.experiment import AlgoSpec, Experiment
@@ -138,7 +138,7 @@ EXPERIMENT = Experiment(
     train_env_fields=("restart_x", "restart_every", "restart_share", "restart_weights", "restart_keep",
                       "restart_back_step", "restart_goal_x", "restart_back_share"),
     success_key="flag_get", progress_key="x_pos", partial_key="restarted", partial_start_key="start_x",
-    env_memory="restart_routes",
+    env_memory="restart_routes", share_env_memory=lend_routes,
     info_keys=("stalled", "start_x", "killed_by"), cause_key="killed_by", cause_name=cause_name,
     eval_episodes=10, ship_by=("world", "stage"), default_model="1-1", score_label="return (shaped, /10)",
 )

@@ -36,8 +36,10 @@ past ``goal_x`` alive in at least ``back_share`` of its last :data:`BACK_WINDOW`
 ``back_step`` closer to the start, and the point's state is found again by replaying the route it
 came from. That is the backward curriculum of Salimans & Chen (2018) run by rule: on 1-3, stepped
 by hand from x 630 to 600, each 10 x took 15-90 rollouts, whatever the hour. Each env steps on its
-own (on 1-3 only half the envs held a crossing at all), ``info["start_x"]`` shows where, and a
-checkpoint keeps each env's x with its routes.
+own, ``info["start_x"]`` shows where, and a checkpoint keeps each env's x with its routes. An env
+whose route never crosses never steps: on 1-3, envs 2, 3, 5 and 6 held a route that falls at x 780
+and sat at x 600 while the others stepped to 510-570 in 40 minutes. So when a run resumes, the envs
+furthest behind take the routes and x of the envs ahead of them, in turn (:func:`lend_routes`).
 
 Evaluation never uses it: both are training-only settings (``Experiment.train_env_fields``), so
 every evaluation and video starts at the level's start. Restarted episodes are marked
@@ -79,6 +81,20 @@ DUMP_EVERY = 4  # frames between the states kept for a warm-up (a dump costs ~2 
 DEATHS_KEPT = 100  # failed episodes per env that weigh the points: ~30 rollouts of 8 envs on 2-2
 BACK_WINDOW = 40  # restarted episodes per env that decide a step back: ~6 rollouts of 8 envs on 1-3
 X_KEY = "x"  # with back_step, the restart_routes entry that holds the env's stepped x
+
+
+def lend_routes(per_env: list[dict]) -> list[dict]:
+    """What each env of a resumed pool gets (``Experiment.share_env_memory``): with a stepping restart
+    x (the routes hold :data:`X_KEY`), the envs whose x is furthest from the start take the routes and
+    x of the envs ahead of them, in turn; the others keep their own. When every env stands at the same
+    x, or none steps, each keeps its own."""
+    xs = [int(np.asarray(kept[X_KEY]).ravel()[0]) if X_KEY in kept else None for kept in per_env]
+    behind = max((x for x in xs if x is not None), default=None)
+    ahead = [kept for kept, x in zip(per_env, xs) if x is not None and x < behind]
+    if not ahead:
+        return per_env
+    lent = iter(range(len(per_env)))
+    return [dict(ahead[next(lent) % len(ahead)]) if x == behind else kept for kept, x in zip(per_env, xs)]
 
 
 class Kept(NamedTuple):

@@ -70,6 +70,9 @@ class Experiment:
     # a checkpoint keeps and a resumed run's env pool gets back (Mario: restart_routes, the buttons that
     # lead to each kept restart point); ignored when the env has no such attribute
     env_memory: str | None = None
+    # rewrites the env memory a resumed pool hands out, one dict per env (Mario: mario_ppo.restarts.
+    # lend_routes, the envs whose restart x is furthest behind take the routes of envs that got further)
+    share_env_memory: Callable[[list[dict]], list[dict]] | None = None
     # config fields that name a shipped model (Mario: world, stage -> saved_networks/mario_ppo/1-1);
     # empty: one model per algorithm, saved_networks/EXPERIMENT/ALGO
     ship_by: tuple[str, ...] = ()

@@ -6,12 +6,14 @@ GOAL unless it is cut short.
 import dataclasses
 from collections import deque
 
+import numpy as np
 import pytest
 
 from mario_ppo.env import make_env
 from mario_ppo.experiment import EXPERIMENT
-from mario_ppo.restarts import X_KEY
+from mario_ppo.restarts import X_KEY, lend_routes
 from rlcore.errors import UserError
+from rlcore.trainers import checkpoints
 from tests.mario_ppo.test_restarts import _restarts, _run_right_past
 
 X, GOAL, STEP, WINDOW = 160, 230, 40, 3
@@ -98,3 +100,30 @@ def test_stepping_back_needs_one_restart_x_and_a_goal_past_it():
         with pytest.raises(UserError, match="--restart-back-step needs"):
             dataclasses.replace(default, **fields)
     dataclasses.replace(default, restart_back_step=STEP, restart_x=X, restart_goal_x=GOAL)
+
+
+def test_a_resumed_pool_lends_the_routes_of_the_envs_ahead_to_the_envs_furthest_behind():
+    def env(x, route):
+        return {"1": np.full(3, route, np.uint8), X_KEY: np.array([x])}
+
+    per_env = [env(600, 0), env(540, 1), env(600, 2), env(570, 3), env(600, 4)]
+    got = lend_routes(per_env)
+    assert [int(kept[X_KEY][0]) for kept in got] == [540, 540, 570, 570, 540]
+    assert [int(kept["1"][0]) for kept in got] == [1, 1, 3, 3, 1]
+    level = [env(600, 0), env(600, 1)]
+    assert lend_routes(level) is level  # all at one x: each keeps its own
+    plain = [{"1": np.zeros(3, np.uint8)}, {}]
+    assert lend_routes(plain) is plain  # no stepping x: nothing to lend
+    assert EXPERIMENT.share_env_memory is lend_routes
+
+
+def test_give_env_memory_hands_out_what_the_experiment_shares():
+    class Pool:
+        num_envs = 2
+
+        def give_memory(self, name, values):
+            self.given = (name, values)
+
+    pool, arrays = Pool(), {"env/0/x": np.array([600]), "env/1/x": np.array([500]), "replay/other": 1}
+    checkpoints.give_env_memory(pool, "routes", arrays, share=lambda per_env: per_env[::-1])
+    assert pool.given == ("routes", [{"x": arrays["env/1/x"]}, {"x": arrays["env/0/x"]}])
