@@ -26,10 +26,12 @@ def _stepping_env(x=X, keep="furthest"):
     return env
 
 
-def _restarted_episodes(env, reach_x, count, seed):
-    """From a reset, play ``count`` restarted episodes, each running right until ``reach_x``; the
-    start x of each, and the info of the reset after the last."""
-    info, starts = env.reset(seed=seed)[1], []
+def _restarted_episodes(env, reach_x, count):
+    """A first episode from the start that passes x and the goal, then ``count`` restarted episodes,
+    each running right until ``reach_x``; the start x of each, and the info of the reset after the last."""
+    env.reset(seed=0)
+    _run_right_past(env, GOAL + 5)
+    info, starts = env.reset(seed=1)[1], []
     for _ in range(count):
         assert info["restarted"]
         starts.append(info["start_x"])
@@ -42,9 +44,7 @@ def _restarted_episodes(env, reach_x, count, seed):
 def test_the_x_steps_back_once_the_window_of_restarts_got_past_the_goal(keep):
     env = _stepping_env(keep=keep)
     try:
-        env.reset(seed=0)
-        _run_right_past(env, GOAL + 5)  # a first episode from the start passes x and the goal
-        starts, info = _restarted_episodes(env, GOAL, WINDOW, seed=1)
+        starts, info = _restarted_episodes(env, GOAL, WINDOW)
         assert all(X <= s < X + 10 for s in starts)  # three restarts from x 160, all past the goal
         assert _restarts(env).x == X - STEP
         assert info["restarted"] and X - STEP <= info["start_x"] < X - STEP + 10
@@ -56,9 +56,7 @@ def test_the_x_steps_back_once_the_window_of_restarts_got_past_the_goal(keep):
 def test_the_x_stays_while_the_restarts_fall_short_of_the_goal():
     env = _stepping_env()
     try:
-        env.reset(seed=0)
-        _run_right_past(env, GOAL + 5)
-        starts, info = _restarted_episodes(env, GOAL - 40, 2 * WINDOW, seed=1)
+        _, info = _restarted_episodes(env, GOAL - 40, 2 * WINDOW)
         assert _restarts(env).x == X and X <= info["start_x"] < X + 10
         assert list(_restarts(env).outcomes) == [False] * WINDOW
     finally:
@@ -68,9 +66,7 @@ def test_the_x_stays_while_the_restarts_fall_short_of_the_goal():
 def test_a_checkpoint_keeps_each_envs_stepped_x():
     first = _stepping_env()
     try:
-        first.reset(seed=0)
-        _run_right_past(first, GOAL + 5)
-        _restarted_episodes(first, GOAL, WINDOW, seed=1)
+        _restarted_episodes(first, GOAL, WINDOW)
         routes = first.get_wrapper_attr("restart_routes")
     finally:
         first.close()
