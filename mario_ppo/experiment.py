@@ -64,7 +64,8 @@ class MarioPPOConfig(PPOConfig):
     restart_back_step: int = field(default=0, metadata={
         "help": "with --restart-x: step each env's restart x back by this many x whenever its restarted "
                 "episodes got past --restart-goal-x in at least --restart-back-share of its last 40, "
-                "a backward curriculum by rule (0 = off: the x stays)", "allowed": OFF_OR_COUNT})
+                "and forward again (never past --restart-x) when at most 10 %% did: a backward "
+                "curriculum by rule (0 = off: the x stays)", "allowed": OFF_OR_COUNT})
     restart_goal_x: int = field(default=0, metadata={
         "help": "with --restart-back-step: the x past which a restarted episode counts as a success "
                 "(past the hard place, e.g. 850 on 1-3)", "allowed": OFF_OR_COUNT})

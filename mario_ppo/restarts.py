@@ -36,7 +36,13 @@ past ``goal_x`` alive in at least ``back_share`` of its last :data:`BACK_WINDOW`
 ``back_step`` closer to the start, and the point's state is found again by replaying the route it
 came from. That is the backward curriculum of Salimans & Chen (2018) run by rule: on 1-3, stepped
 by hand from x 630 to 600, each 10 x took 15-90 rollouts, whatever the hour. Each env steps on its
-own, ``info["start_x"]`` shows where, and a checkpoint keeps each env's x with its routes. An env
+own, ``info["start_x"]`` shows where, and a checkpoint keeps each env's x with its routes. When at
+most :data:`FORWARD_SHARE` of the window got past, the x steps forward again (never past the x the
+env was built with): each env then stays where its restarts succeed sometimes but not mostly, the
+"starts of intermediate difficulty" of reverse curriculum generation (Florensa et al. 2017, whose
+bounds were 0.1 and 0.9). On 1-3 an env stepped from x 520 (23-29 % got past) to 510, the takeoff of
+the jump onto the low treetop, where none of ~650 restarts got past, and without the forward step
+it would have stayed there for good. An env
 whose route never crosses never steps: on 1-3, envs 2, 3, 5 and 6 held a route that falls at x 780
 and sat at x 600 while the others stepped to 510-570 in 40 minutes. So when a run resumes, the envs
 furthest behind take the routes and x of the envs ahead of them, in turn (:func:`lend_routes`).
@@ -81,6 +87,7 @@ DUMP_EVERY = 4  # frames between the states kept for a warm-up (a dump costs ~2 
 DEATHS_KEPT = 100  # failed episodes per env that weigh the points: ~30 rollouts of 8 envs on 2-2
 BACK_WINDOW = 40  # restarted episodes per env that decide a step back: ~6 rollouts of 8 envs on 1-3
 X_KEY = "x"  # with back_step, the restart_routes entry that holds the env's stepped x
+FORWARD_SHARE = 0.1  # with back_step: at most this share of the window got past the goal -> step forward
 
 
 def lend_routes(per_env: list[dict]) -> list[dict]:
@@ -148,6 +155,7 @@ class Restarts(gym.Wrapper):
             raise ValueError(f"unknown restart keep rule {keep!r}; choose one of {', '.join(KEEPS)}")
         self.x, self.every, self.share, self.weights, self.keep = x, every, share, weights, keep
         self.back_step, self.goal_x, self.back_share = back_step, goal_x, back_share
+        self.built_x = x  # a stepping x never goes past it
         self.outcomes: deque[bool] = deque(maxlen=back_window)  # restarted episodes: got past goal_x?
         self.failures: deque[int] = deque(maxlen=DEATHS_KEPT)  # the point each failed episode ended at
         self._last: dict | None = None  # the info of this episode's last step (None: no step yet)
@@ -209,15 +217,20 @@ class Restarts(gym.Wrapper):
 
     def _judge_restart(self, got_past: bool) -> None:
         """Count a restarted episode's outcome; step the x back when enough of the last ones got past
-        the goal (while the x stays above 0; behind the level's start, restarts start there)."""
+        the goal (while the x stays above 0; behind the level's start, restarts start there), forward
+        when hardly any did (while it stays at or behind the x the env was built with)."""
         self.outcomes.append(got_past)
-        full = len(self.outcomes) == self.outcomes.maxlen
-        if full and np.mean(self.outcomes) >= self.back_share and self.x > self.back_step:
+        if len(self.outcomes) < self.outcomes.maxlen:
+            return
+        share = np.mean(self.outcomes)
+        if share >= self.back_share and self.x > self.back_step:
             self._move_to(self.x - self.back_step)
+        elif share <= FORWARD_SHARE and self.x + self.back_step <= self.built_x:
+            self._move_to(self.x + self.back_step)
 
     def _move_to(self, x: int) -> None:
-        """Restart from ``x`` (behind the current x): its state comes from replaying the kept route,
-        which passes it. The env must be reset before its next step."""
+        """Restart from ``x`` (behind the x the env was built with): its state comes from replaying the
+        kept route, which passes it. The env must be reset before its next step."""
         routes = self.restart_routes
         routes.pop(X_KEY, None)
         self.x = x
@@ -283,7 +296,7 @@ class Restarts(gym.Wrapper):
         routes = dict(routes)
         stepped = routes.pop(X_KEY, None)
         if self.back_step and stepped is not None:
-            self.x = min(self.x, int(np.asarray(stepped).ravel()[0]))
+            self.x = min(self.built_x, int(np.asarray(stepped).ravel()[0]))
         for key, route in sorted(routes.items(), key=lambda item: int(item[0])):
             route = np.asarray(route, np.uint8)
             passed, end_x = self._replay(route)

@@ -63,6 +63,21 @@ def test_the_x_stays_while_the_restarts_fall_short_of_the_goal():
         env.close()
 
 
+def test_the_x_steps_forward_again_when_hardly_any_restart_gets_past_but_never_past_where_it_began():
+    env = _stepping_env()
+    try:
+        _restarted_episodes(env, GOAL, WINDOW)  # three past the goal: back to x 120
+        assert _restarts(env).x == X - STEP
+        for _ in range(WINDOW):  # three from x 120 that stop short of the goal
+            info = env.reset()[1]
+            assert info["restarted"] and X - STEP <= info["start_x"] < X - STEP + 10
+            _run_right_past(env, GOAL - 40)
+        info = env.reset()[1]
+        assert _restarts(env).x == X and X <= info["start_x"] < X + 10
+    finally:
+        env.close()
+
+
 def test_a_checkpoint_keeps_each_envs_stepped_x():
     first = _stepping_env()
     try:
