@@ -45,7 +45,8 @@ the jump onto the low treetop, where none of ~650 restarts got past, and without
 it would have stayed there for good. An env
 whose route never crosses never steps: on 1-3, envs 2, 3, 5 and 6 held a route that falls at x 780
 and sat at x 600 while the others stepped to 510-570 in 40 minutes. So when a run resumes, the envs
-furthest behind take the routes and x of the envs ahead of them, in turn (:func:`lend_routes`).
+still at its ``restart_x`` take the routes and x of the envs that stepped back, in turn
+(:func:`lend_routes`).
 
 Evaluation never uses it: both are training-only settings (``Experiment.train_env_fields``), so
 every evaluation and video starts at the level's start. Restarted episodes are marked
@@ -90,18 +91,18 @@ X_KEY = "x"  # with back_step, the restart_routes entry that holds the env's ste
 FORWARD_SHARE = 0.1  # with back_step: at most this share of the window got past the goal -> step forward
 
 
-def lend_routes(per_env: list[dict]) -> list[dict]:
+def lend_routes(per_env: list[dict], config) -> list[dict]:
     """What each env of a resumed pool gets (``Experiment.share_env_memory``): with a stepping restart
-    x (the routes hold :data:`X_KEY`), the envs whose x is furthest from the start take the routes and
-    x of the envs ahead of them, in turn; the others keep their own. When every env stands at the same
-    x, or none steps, each keeps its own."""
+    x (the routes hold :data:`X_KEY`), the envs still at the run's ``restart_x`` (whose restarts never
+    got past the goal often enough to step back) take the routes and x of the envs that stepped back,
+    in turn; the others keep their own."""
     xs = [int(np.asarray(kept[X_KEY]).ravel()[0]) if X_KEY in kept else None for kept in per_env]
-    behind = max((x for x in xs if x is not None), default=None)
-    ahead = [kept for kept, x in zip(per_env, xs) if x is not None and x < behind]
-    if not ahead:
+    stuck = [x is not None and x >= config.restart_x for x in xs]
+    ahead = [kept for kept, x in zip(per_env, xs) if x is not None and x < config.restart_x]
+    if not (ahead and any(stuck)):
         return per_env
     lent = iter(range(len(per_env)))
-    return [dict(ahead[next(lent) % len(ahead)]) if x == behind else kept for kept, x in zip(per_env, xs)]
+    return [dict(ahead[next(lent) % len(ahead)]) if at_start else kept for kept, at_start in zip(per_env, stuck)]
 
 
 class Kept(NamedTuple):

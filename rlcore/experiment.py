@@ -70,9 +70,10 @@ class Experiment:
     # a checkpoint keeps and a resumed run's env pool gets back (Mario: restart_routes, the buttons that
     # lead to each kept restart point); ignored when the env has no such attribute
     env_memory: str | None = None
-    # rewrites the env memory a resumed pool hands out, one dict per env (Mario: mario_ppo.restarts.
-    # lend_routes, the envs whose restart x is furthest behind take the routes of envs that got further)
-    share_env_memory: Callable[[list[dict]], list[dict]] | None = None
+    # share_env_memory(per_env, config) rewrites the env memory a resumed pool hands out, one dict per
+    # env (Mario: mario_ppo.restarts.lend_routes, envs whose restart x never stepped back take the
+    # routes of envs whose x did)
+    share_env_memory: Callable[[list[dict], object], list[dict]] | None = None
     # config fields that name a shipped model (Mario: world, stage -> saved_networks/mario_ppo/1-1);
     # empty: one model per algorithm, saved_networks/EXPERIMENT/ALGO
     ship_by: tuple[str, ...] = ()

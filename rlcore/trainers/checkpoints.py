@@ -61,9 +61,9 @@ def env_memory(envs, name: str | None) -> dict:
             for key, value in values.items()}
 
 
-def give_env_memory(envs, name: str | None, arrays: dict, share=None) -> None:
+def give_env_memory(envs, name: str | None, arrays: dict, share=None, config=None) -> None:
     """Hand each env of a resumed run what it had built up (:func:`env_memory`'s arrays), first
-    rewritten by ``share`` (``Experiment.share_env_memory``) when given."""
+    rewritten by ``share(per_env, config)`` (``Experiment.share_env_memory``) when given."""
     if not name:
         return
     per_env = [{} for _ in range(envs.num_envs)]
@@ -73,7 +73,7 @@ def give_env_memory(envs, name: str | None, arrays: dict, share=None) -> None:
             if int(i) < envs.num_envs:
                 per_env[int(i)][inner] = value
     if any(per_env):
-        envs.give_memory(name, share(per_env) if share else per_env)
+        envs.give_memory(name, share(per_env, config) if share else per_env)
 
 
 def _restore_replay(run_dir: Path, state: dict, arrays: dict, memory: ReplayMemory) -> None:

@@ -62,7 +62,7 @@ def train(spec: RunSpec) -> Path:
     state, arrays = checkpoints.restore(spec, agent, rng)
     if state is not None:
         parent = state.get("init_from")
-        checkpoints.give_env_memory(envs, exp.env_memory, arrays, exp.share_env_memory)  # Mario: restart points
+        checkpoints.give_env_memory(envs, exp.env_memory, arrays, exp.share_env_memory, cfg)  # Mario: restarts
     else:
         parent = init_weights(agent, cfg.init_from, exp.name, spec.algo) if cfg.init_from else None
     session = TrainingSession(spec, state, progress_unit="step")

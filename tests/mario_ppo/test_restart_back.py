@@ -113,18 +113,22 @@ def test_stepping_back_needs_one_restart_x_and_a_goal_past_it():
     dataclasses.replace(default, restart_back_step=STEP, restart_x=X, restart_goal_x=GOAL)
 
 
-def test_a_resumed_pool_lends_the_routes_of_the_envs_ahead_to_the_envs_furthest_behind():
+def test_a_resumed_pool_lends_the_routes_of_envs_that_stepped_back_to_envs_that_never_did():
     def env(x, route):
         return {"1": np.full(3, route, np.uint8), X_KEY: np.array([x])}
 
+    run = dataclasses.replace(EXPERIMENT.preset("ppo", "levels"), restart_x=600, restart_back_step=10,
+                              restart_goal_x=850)
     per_env = [env(600, 0), env(540, 1), env(600, 2), env(570, 3), env(600, 4)]
-    got = lend_routes(per_env)
+    got = lend_routes(per_env, run)
     assert [int(kept[X_KEY][0]) for kept in got] == [540, 540, 570, 570, 540]
     assert [int(kept["1"][0]) for kept in got] == [1, 1, 3, 3, 1]
+    stepped = [env(510, 0), env(540, 1)]
+    assert lend_routes(stepped, run) is stepped  # every env stepped back: each keeps its own
     level = [env(600, 0), env(600, 1)]
-    assert lend_routes(level) is level  # all at one x: each keeps its own
+    assert lend_routes(level, run) is level  # none did: nothing to lend
     plain = [{"1": np.zeros(3, np.uint8)}, {}]
-    assert lend_routes(plain) is plain  # no stepping x: nothing to lend
+    assert lend_routes(plain, run) is plain  # no stepping x
     assert EXPERIMENT.share_env_memory is lend_routes
 
 
@@ -136,5 +140,7 @@ def test_give_env_memory_hands_out_what_the_experiment_shares():
             self.given = (name, values)
 
     pool, arrays = Pool(), {"env/0/x": np.array([600]), "env/1/x": np.array([500]), "replay/other": 1}
-    checkpoints.give_env_memory(pool, "routes", arrays, share=lambda per_env: per_env[::-1])
+    checkpoints.give_env_memory(pool, "routes", arrays, share=lambda per_env, config: per_env[::config])
+    assert pool.given == ("routes", [{"x": arrays["env/0/x"]}, {"x": arrays["env/1/x"]}])
+    checkpoints.give_env_memory(pool, "routes", arrays, lambda per_env, config: per_env[::config], -1)
     assert pool.given == ("routes", [{"x": arrays["env/1/x"]}, {"x": arrays["env/0/x"]}])
