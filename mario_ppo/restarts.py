@@ -31,22 +31,8 @@ learning from one demonstration (Salimans & Chen 2018), the demonstration being 
 crossing. An episode's reach is the furthest x it reached alive (the flag: past every x); when it
 ends, a state it passed is kept where its reach is at least that of the state kept there.
 
-A restart x can also step itself back (``back_step``): each time this env's restarted episodes got
-past ``goal_x`` alive in at least ``back_share`` of its last :data:`BACK_WINDOW`, the x moves
-``back_step`` closer to the start, and the point's state is found again by replaying the route it
-came from. That is the backward curriculum of Salimans & Chen (2018) run by rule: on 1-3, stepped
-by hand from x 630 to 600, each 10 x took 15-90 rollouts, whatever the hour. Each env steps on its
-own, ``info["start_x"]`` shows where, and a checkpoint keeps each env's x with its routes. When at
-most :data:`FORWARD_SHARE` of the window got past, the x steps forward again (never past the x the
-env was built with): each env then stays where its restarts succeed sometimes but not mostly, the
-"starts of intermediate difficulty" of reverse curriculum generation (Florensa et al. 2017, whose
-bounds were 0.1 and 0.9). On 1-3 an env stepped from x 520 (23-29 % got past) to 510, the takeoff of
-the jump onto the low treetop, where none of ~650 restarts got past, and without the forward step
-it would have stayed there for good. An env
-whose route never crosses never steps: on 1-3, envs 2, 3, 5 and 6 held a route that falls at x 780
-and sat at x 600 while the others stepped to 510-570 in 40 minutes. So when a run resumes, the envs
-still at its ``restart_x`` take the routes and x of the envs that stepped back, in turn
-(:func:`lend_routes`).
+A single restart x can also step itself back towards the start as the restarts from it succeed, a
+backward curriculum by rule (``back_step``; :mod:`mario_ppo.curriculum` says how and why).
 
 Evaluation never uses it: both are training-only settings (``Experiment.train_env_fields``), so
 every evaluation and video starts at the level's start. Restarted episodes are marked
@@ -80,29 +66,14 @@ from typing import NamedTuple
 import gymnasium as gym
 import numpy as np
 
+from mario_ppo.curriculum import X_KEY, StepBack
+
 WEIGHTS = ("uniform", "deaths")
 KEEPS = ("latest", "furthest")
 FLAG = 10**9  # the reach of an episode that got the flag: past every x
 WARMUP = 16  # frames shown from a restart's replay: 4 agent steps of 4 frames, what the frame stacks show
 DUMP_EVERY = 4  # frames between the states kept for a warm-up (a dump costs ~2 % of a frame)
 DEATHS_KEPT = 100  # failed episodes per env that weigh the points: ~30 rollouts of 8 envs on 2-2
-BACK_WINDOW = 40  # restarted episodes per env that decide a step back: ~6 rollouts of 8 envs on 1-3
-X_KEY = "x"  # with back_step, the restart_routes entry that holds the env's stepped x
-FORWARD_SHARE = 0.1  # with back_step: at most this share of the window got past the goal -> step forward
-
-
-def lend_routes(per_env: list[dict], config) -> list[dict]:
-    """What each env of a resumed pool gets (``Experiment.share_env_memory``): with a stepping restart
-    x (the routes hold :data:`X_KEY`), the envs still at the run's ``restart_x`` (whose restarts never
-    got past the goal often enough to step back) take the routes and x of the envs that stepped back,
-    in turn; the others keep their own."""
-    xs = [int(np.asarray(kept[X_KEY]).ravel()[0]) if X_KEY in kept else None for kept in per_env]
-    stuck = [x is not None and x >= config.restart_x for x in xs]
-    ahead = [kept for kept, x in zip(per_env, xs) if x is not None and x < config.restart_x]
-    if not (ahead and any(stuck)):
-        return per_env
-    lent = iter(range(len(per_env)))
-    return [dict(ahead[next(lent) % len(ahead)]) if at_start else kept for kept, at_start in zip(per_env, stuck)]
 
 
 class Kept(NamedTuple):
@@ -139,25 +110,20 @@ class Restarts(gym.Wrapper):
     live in this env; ``restart_routes`` gets and sets them as routes (a resumed run's pool sets what
     the checkpoint kept). With ``weights="deaths"`` the point is drawn by :func:`death_weights`; with
     ``keep="furthest"`` a point keeps the state of the episode that went furthest past it instead.
-    With ``back_step``, ``x`` steps back by rule (see the module's docstring).
+    With ``back_step``, ``x`` moves by the rule of :class:`~mario_ppo.curriculum.StepBack`.
     """
 
     def __init__(self, env: gym.Env, share: float, x: int = 0, every: int = 0, weights: str = "uniform",
-                 keep: str = "latest", back_step: int = 0, goal_x: int = 0, back_share: float = 0.5,
-                 back_window: int = BACK_WINDOW):
+                 keep: str = "latest", back_step: int = 0, goal_x: int = 0, back_share: float = 0.5):
         super().__init__(env)
         if bool(x) == bool(every):
             raise ValueError("give one of x (a single restart point) and every (a spacing)")
-        if back_step and not (x and goal_x > x):
-            raise ValueError("a restart x steps back only from a single x (x) towards a goal past it (goal_x > x)")
         if weights not in WEIGHTS:
             raise ValueError(f"unknown restart weights {weights!r}; choose one of {', '.join(WEIGHTS)}")
         if keep not in KEEPS:
             raise ValueError(f"unknown restart keep rule {keep!r}; choose one of {', '.join(KEEPS)}")
         self.x, self.every, self.share, self.weights, self.keep = x, every, share, weights, keep
-        self.back_step, self.goal_x, self.back_share = back_step, goal_x, back_share
-        self.built_x = x  # a stepping x never goes past it
-        self.outcomes: deque[bool] = deque(maxlen=back_window)  # restarted episodes: got past goal_x?
+        self.stepper = StepBack(x, back_step, goal_x, back_share) if back_step else None
         self.failures: deque[int] = deque(maxlen=DEATHS_KEPT)  # the point each failed episode ended at
         self._last: dict | None = None  # the info of this episode's last step (None: no step yet)
         self._snapshots: dict[int, Kept] = {}  # point number -> how to start there
@@ -182,8 +148,8 @@ class Restarts(gym.Wrapper):
         if self._last is not None and not self._last.get("flag_get"):
             self.failures.append(self.point(self._last["x_pos"]))
         self._keep_furthest(self._passed_states, self._furthest_x, bytes(self._route[: self._furthest_frame]))
-        if self.back_step and self._restarted and self._last is not None:
-            self._judge_restart(self._furthest_x >= self.goal_x)
+        if self.stepper and self._restarted and self._last is not None and self.stepper.judge(self._furthest_x):
+            self._move_to(self.stepper.x)
         self._last = None
         self._passed_states, self._furthest_x, self._furthest_frame = {}, 0, 0
         obs, info = self.env.reset(seed=seed, options=options)
@@ -216,19 +182,6 @@ class Restarts(gym.Wrapper):
         info["warmup_frames"] = frames[-WARMUP:]
         return obs, info
 
-    def _judge_restart(self, got_past: bool) -> None:
-        """Count a restarted episode's outcome; step the x back when enough of the last ones got past
-        the goal (while the x stays above 0; behind the level's start, restarts start there), forward
-        when hardly any did (while it stays at or behind the x the env was built with)."""
-        self.outcomes.append(got_past)
-        if len(self.outcomes) < self.outcomes.maxlen:
-            return
-        share = np.mean(self.outcomes)
-        if share >= self.back_share and self.x > self.back_step:
-            self._move_to(self.x - self.back_step)
-        elif share <= FORWARD_SHARE and self.x + self.back_step <= self.built_x:
-            self._move_to(self.x + self.back_step)
-
     def _move_to(self, x: int) -> None:
         """Restart from ``x`` (behind the x the env was built with): its state comes from replaying the
         kept route, which passes it. The env must be reset before its next step."""
@@ -236,7 +189,6 @@ class Restarts(gym.Wrapper):
         routes.pop(X_KEY, None)
         self.x = x
         self._snapshots, self._reach, self._full_routes = {}, {}, {}  # a flag's reach would outrank its replay's
-        self.outcomes.clear()
         self.restart_routes = routes
 
     @staticmethod
@@ -282,7 +234,7 @@ class Restarts(gym.Wrapper):
         routes = (self._full_routes if self.keep == "furthest"
                   else {point: kept.route for point, kept in self._snapshots.items()})
         kept = {str(point): np.frombuffer(route, np.uint8) for point, route in routes.items()}
-        if self.back_step:
+        if self.stepper:
             kept[X_KEY] = np.array([self.x], np.int64)
         return kept
 
@@ -296,8 +248,8 @@ class Restarts(gym.Wrapper):
         The env must be reset before its next step."""
         routes = dict(routes)
         stepped = routes.pop(X_KEY, None)
-        if self.back_step and stepped is not None:
-            self.x = min(self.built_x, int(np.asarray(stepped).ravel()[0]))
+        if self.stepper and stepped is not None:
+            self.x = self.stepper.restore(int(np.asarray(stepped).ravel()[0]))
         for key, route in sorted(routes.items(), key=lambda item: int(item[0])):
             route = np.asarray(route, np.uint8)
             passed, end_x = self._replay(route)

@@ -11,7 +11,7 @@ import pytest
 
 from mario_ppo.env import make_env
 from mario_ppo.experiment import EXPERIMENT
-from mario_ppo.restarts import X_KEY, lend_routes
+from mario_ppo.curriculum import X_KEY, StepBack, lend_routes
 from rlcore.errors import UserError
 from rlcore.trainers import checkpoints
 from tests.mario_ppo.test_restarts import _restarts, _run_right_past
@@ -22,7 +22,7 @@ X, GOAL, STEP, WINDOW = 160, 230, 40, 3
 def _stepping_env(x=X, keep="furthest"):
     env = make_env(restart_x=x, restart_share=1.0, restart_keep=keep, restart_back_step=STEP,
                    restart_goal_x=GOAL)
-    _restarts(env).outcomes = deque(maxlen=WINDOW)  # decide on 3 restarted episodes, not 40
+    _restarts(env).stepper.outcomes = deque(maxlen=WINDOW)  # decide on 3 restarted episodes, not 40
     return env
 
 
@@ -48,7 +48,7 @@ def test_the_x_steps_back_once_the_window_of_restarts_got_past_the_goal(keep):
         assert all(X <= s < X + 10 for s in starts)  # three restarts from x 160, all past the goal
         assert _restarts(env).x == X - STEP
         assert info["restarted"] and X - STEP <= info["start_x"] < X - STEP + 10
-        assert len(_restarts(env).outcomes) == 0  # the new x is judged on its own restarts
+        assert len(_restarts(env).stepper.outcomes) == 0  # the new x is judged on its own restarts
     finally:
         env.close()
 
@@ -58,7 +58,7 @@ def test_the_x_stays_while_the_restarts_fall_short_of_the_goal():
     try:
         _, info = _restarted_episodes(env, GOAL - 40, 2 * WINDOW)
         assert _restarts(env).x == X and X <= info["start_x"] < X + 10
-        assert list(_restarts(env).outcomes) == [False] * WINDOW
+        assert list(_restarts(env).stepper.outcomes) == [False] * WINDOW
     finally:
         env.close()
 
@@ -101,6 +101,17 @@ def test_a_checkpoint_keeps_each_envs_stepped_x():
         assert _restarts(plain).x == X and X_KEY not in plain.get_wrapper_attr("restart_routes")
     finally:
         plain.close()
+
+
+def test_the_rule_steps_back_at_half_forward_at_a_tenth_and_holds_in_between():
+    rule = StepBack(600, 10, 850, back_share=0.5, window=10)
+    moves = [rule.judge(reach) for reach in [900] * 5 + [800] * 5]  # 5 of 10 past the goal
+    assert moves == [False] * 9 + [True] and rule.x == 590 and len(rule.outcomes) == 0
+    moves = [rule.judge(reach) for reach in [900] * 2 + [800] * 8]  # 2 of 10: in between, no move
+    assert not any(moves) and rule.x == 590
+    assert rule.judge(800) and rule.x == 600  # one more miss: 1 of the last 10, forward again
+    assert not any(rule.judge(800) for _ in range(30)) and rule.x == 600  # never past where it began
+    assert rule.restore(550) == 550 and rule.restore(650) == 600
 
 
 def test_stepping_back_needs_one_restart_x_and_a_goal_past_it():
