@@ -8,11 +8,11 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass, field
 
+from mario_ppo.curriculum import lend_routes
 from mario_ppo.deaths import cause_name
 from mario_ppo.env import ACTION_SETS, FRAME_STACKS, make_env
 from mario_ppo.episode_ends import StallLimit
 from mario_ppo.levels import STAGE, WORLD
-from mario_ppo.curriculum import lend_routes
 from mario_ppo.restarts import KEEPS, WEIGHTS
 from rlcore.allowed import OFF_OR_COUNT, Allowed, choices, require
 from rlcore.configs import PPOConfig

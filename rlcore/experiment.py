@@ -71,7 +71,7 @@ class Experiment:
     # lead to each kept restart point); ignored when the env has no such attribute
     env_memory: str | None = None
     # share_env_memory(per_env, config) rewrites the env memory a resumed pool hands out, one dict per
-    # env (Mario: mario_ppo.restarts.lend_routes, envs whose restart x never stepped back take the
+    # env (Mario: mario_ppo.curriculum.lend_routes, envs whose restart x never stepped back take the
     # routes of envs whose x did)
     share_env_memory: Callable[[list[dict], object], list[dict]] | None = None
     # config fields that name a shipped model (Mario: world, stage -> saved_networks/mario_ppo/1-1);
