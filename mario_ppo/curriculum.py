@@ -25,6 +25,7 @@ TensorFlow-free: env-pool worker processes import this module.
 from __future__ import annotations
 
 from collections import deque
+from itertools import cycle
 
 import numpy as np
 
@@ -72,10 +73,15 @@ def lend_routes(per_env: list[dict], config) -> list[dict]:
     x (the routes hold :data:`X_KEY`), the envs still at the run's ``restart_x`` (whose restarts never
     got past the goal often enough to step back) take the routes and x of the envs that stepped back,
     in turn; the others keep their own."""
-    xs = [int(np.asarray(kept[X_KEY]).ravel()[0]) if X_KEY in kept else None for kept in per_env]
+    xs = [stepped_x(kept) for kept in per_env]
     stuck = [x is not None and x >= config.restart_x for x in xs]
     ahead = [kept for kept, x in zip(per_env, xs) if x is not None and x < config.restart_x]
     if not (ahead and any(stuck)):
         return per_env
-    lent = iter(range(len(per_env)))
-    return [dict(ahead[next(lent) % len(ahead)]) if at_start else kept for kept, at_start in zip(per_env, stuck)]
+    lenders = cycle(ahead)
+    return [dict(next(lenders)) if at_start else kept for kept, at_start in zip(per_env, stuck)]
+
+
+def stepped_x(routes: dict) -> int | None:
+    """The stepped x an env's routes (``restart_routes``) hold, None when they hold none."""
+    return int(np.asarray(routes[X_KEY]).ravel()[0]) if X_KEY in routes else None

@@ -66,7 +66,7 @@ from typing import NamedTuple
 import gymnasium as gym
 import numpy as np
 
-from mario_ppo.curriculum import X_KEY, StepBack
+from mario_ppo.curriculum import X_KEY, StepBack, stepped_x
 
 WEIGHTS = ("uniform", "deaths")
 KEEPS = ("latest", "furthest")
@@ -247,9 +247,10 @@ class Restarts(gym.Wrapper):
         back_step, the env's stepped x comes back first (never past the x it was built with).
         The env must be reset before its next step."""
         routes = dict(routes)
-        stepped = routes.pop(X_KEY, None)
+        stepped = stepped_x(routes)
+        routes.pop(X_KEY, None)
         if self.stepper and stepped is not None:
-            self.x = self.stepper.restore(int(np.asarray(stepped).ravel()[0]))
+            self.x = self.stepper.restore(stepped)
         for key, route in sorted(routes.items(), key=lambda item: int(item[0])):
             route = np.asarray(route, np.uint8)
             passed, end_x = self._replay(route)
