@@ -17,15 +17,12 @@ import dataclasses
 import json
 import os
 import sys
-import time
-from functools import partial
 from pathlib import Path
 
 os.environ.setdefault("TF_CPP_MIN_LOG_LEVEL", "3")
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-import numpy as np  # noqa: E402
-from common import emit, random_env_rate  # noqa: E402
+from common import emit, pool_rate, random_env_rate  # noqa: E402
 
 from cartpole.experiment import make_env  # noqa: E402
 
@@ -35,22 +32,11 @@ def bench_env():
 
 
 def bench_pool(seconds=3.0):
-    from rlcore.vector import EnvPool
-
-    rng = np.random.default_rng(0)
     for mode in ("inline", "processes"):
         for n in (1, 2, 4, 8):
-            started = time.perf_counter()
-            with EnvPool([partial(make_env)] * n, mode=mode) as pool:
-                pool.reset(seed=0)
-                startup = time.perf_counter() - started
-                vector_steps, start = 0, time.perf_counter()
-                while time.perf_counter() - start < seconds:
-                    pool.step(rng.integers(0, 2, n))
-                    vector_steps += 1
-                elapsed = time.perf_counter() - start
+            startup, rate = pool_rate(make_env, n, mode, n_actions=2, seconds=seconds)
             emit(bench="pool", env="CartPole-v1", mode=mode, num_envs=n, startup_s=round(startup, 2),
-                 agent_steps_per_s=round(vector_steps * n / elapsed))
+                 agent_steps_per_s=round(rate))
 
 
 def bench_train(algo: str, experiment: str, no_eval: bool = False):

@@ -30,7 +30,7 @@ os.environ.setdefault("TF_CPP_MIN_LOG_LEVEL", "3")
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import numpy as np  # noqa: E402
-from common import emit, random_env_rate  # noqa: E402
+from common import emit, pool_rate, random_env_rate  # noqa: E402
 
 from mario_ppo.experiment import EXPERIMENT  # noqa: E402
 
@@ -49,25 +49,14 @@ def bench_emulator(seconds: float):
 
 
 def bench_pool(seconds: float):
-    from rlcore.vector import EnvPool
-
-    rng = np.random.default_rng(0)
     make = EXPERIMENT.env_factory(CFG)
     for mode in ("processes", "inline"):
         for n in (1, 2, 4, 8):
             if mode == "inline" and n > 2:
                 continue  # one process: no faster than the single env; shown for 1 and 2
-            started = time.perf_counter()
-            with EnvPool([make] * n, mode=mode) as pool:
-                pool.reset(seed=0)
-                startup = time.perf_counter() - started
-                vector_steps, start = 0, time.perf_counter()
-                while time.perf_counter() - start < seconds:
-                    pool.step(rng.integers(0, 7, n))
-                    vector_steps += 1
-                elapsed = time.perf_counter() - start
+            startup, rate = pool_rate(make, n, mode, n_actions=7, seconds=seconds)
             emit(bench="pool", mode=mode, num_envs=n, startup_s=round(startup, 2),
-                 agent_steps_per_s=round(vector_steps * n / elapsed, 1))
+                 agent_steps_per_s=round(rate, 1))
 
 
 def bench_agent(precision: str):
