@@ -25,6 +25,13 @@ def run(capsys, *argv):
     return code, out, err
 
 
+def status_lines(capsys, run_dir, *options) -> list[str]:
+    """The lines `main.py status RUN_DIR OPTIONS` prints, once it has exited 0."""
+    code, out, err = run(capsys, "status", str(run_dir), *options)
+    assert code == 0, err
+    return out.splitlines()
+
+
 @pytest.fixture
 def dqn_model_dir(tmp_path):
     """An untrained LunarLander DQN model folder, written as training writes one."""

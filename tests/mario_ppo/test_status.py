@@ -4,7 +4,7 @@ from pathlib import Path
 import pandas as pd
 
 from tests.mario_ppo.test_plots import write_run
-from tests.test_cli import run
+from tests.test_cli import run, status_lines
 
 ROOT = Path(__file__).resolve().parents[2]
 HEADER = ("episode,total_points,av_latest_points,target_ave_scores,env_steps,x_pos,success,success_share,"
@@ -19,9 +19,7 @@ def test_status_counts_flags_per_block_of_full_episodes_and_restarts_beside_them
         cause = "" if won else (-1 if i % 3 else 10)  # fell, or a grey Cheep-cheep
         rows.append(f"{i},{10 * i},0,0,{100 * i},{20 * i},{won},0,{restarted},{cause}")
     write_run(tmp_path, rows)
-    code, out, err = run(capsys, "status", str(tmp_path), "--block", "20", "--blocks", "2")
-    assert code == 0, err
-    lines = out.splitlines()
+    lines = status_lines(capsys, tmp_path, "--block", "20", "--blocks", "2")
     assert lines[0] == ("mario_ppo ppo (default preset, seed 0): checkpoint at 28,672 env steps, 60 episodes, "
                         "1.5 h of training")
     df = pd.read_csv(tmp_path / "metrics.csv")
@@ -46,18 +44,15 @@ def test_status_says_where_the_restarted_episodes_of_a_block_started(capsys, tmp
         start = 40 if i % 2 == 0 else (600 if i < 11 else 590 + (i % 4 == 1) * 10)
         rows.append(f"{i},{10 * i},0,0,{100 * i},{700 + i},0,0,{i % 2},-1,{start}")
     write_run(tmp_path, rows)
-    code, out, err = run(capsys, "status", str(tmp_path), "--block", "5", "--blocks", "2")
-    assert code == 0, err
-    first, second = out.splitlines()[1:3]
+    first, second = status_lines(capsys, tmp_path, "--block", "5", "--blocks", "2")[1:3]
     assert first.endswith("| restarted 4 (0 flag_get) from start_x 600")
     assert second.endswith("| restarted 4 (0 flag_get) from start_x 590-600")
 
 
 def test_status_of_a_shipped_level_reads_its_meta_and_ends_at_its_last_episode(capsys):
     folder = ROOT / "saved_networks" / "mario_ppo" / "1-4"
-    code, out, err = run(capsys, "status", str(folder), "--block", "100", "--blocks", "1")
-    assert code == 0, err
-    head, block, rollouts = out.splitlines()  # one block of episodes, one of 20 rollouts
+    # one block of episodes, one of 20 rollouts
+    head, block, rollouts = status_lines(capsys, folder, "--block", "100", "--blocks", "1")
     assert head.startswith("mario_ppo ppo (default preset, seed 0): model at 901,120 env steps, ")
     df = pd.read_csv(folder / "metrics.csv").tail(100)
     wins = df.success.sum()
@@ -83,9 +78,7 @@ def test_status_shows_blocks_of_rollouts_with_update_sizes_and_the_learning_rate
         rows.append(f"{r},{4096 * r},{10 + r},{r},4,{r % 3},{1.0 - r / 100},{r / 1000},{r / 100},"
                     f"{1e-4 if r < 6 else 5e-5},{'' if r < 3 else 0.003}")
     (tmp_path / "rollouts.csv").write_text("\n".join(rows) + "\n")
-    code, out, err = run(capsys, "status", str(tmp_path), "--rollout-block", "3", "--blocks", "2")
-    assert code == 0, err
-    lines = out.splitlines()[-2:]
+    lines = status_lines(capsys, tmp_path, "--rollout-block", "3", "--blocks", "2")[-2:]
     df = pd.read_csv(tmp_path / "rollouts.csv")
     for line, part in zip(lines, (df.iloc[1:4], df.iloc[4:7])):
         wins, starts = part.successes.sum(), (part.episodes_ended - part.restarted_episodes).sum()

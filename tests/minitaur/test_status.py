@@ -2,7 +2,7 @@
 import pandas as pd
 
 from rlcore.checkpoint import save_checkpoint
-from tests.test_cli import run
+from tests.test_cli import status_lines
 
 
 def test_status_of_a_minitaur_run_shows_length_distance_and_the_last_evaluations(capsys, tmp_path):
@@ -15,9 +15,7 @@ def test_status_of_a_minitaur_run_shows_length_distance_and_the_last_evaluations
     save_checkpoint(tmp_path / "checkpoint.npz", {}, {}, {
         "experiment": "minitaur", "algo": "sac", "preset": "default", "seed": 0, "config": {"window": 10},
         "env_steps": 9000, "returns": [0.0] * 30, "wall_seconds": 3600.0})
-    code, out, err = run(capsys, "status", str(tmp_path), "--block", "10", "--blocks", "2")
-    assert code == 0, err
-    lines = out.splitlines()
+    lines = status_lines(capsys, tmp_path, "--block", "10", "--blocks", "2")
     assert lines[0] == ("minitaur sac (default preset, seed 0): checkpoint at 9,000 env steps, 30 episodes, "
                         "1.0 h of training")
     df = pd.read_csv(tmp_path / "metrics.csv")
