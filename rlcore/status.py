@@ -3,11 +3,12 @@
 For a run that lasts many sessions (a Mario level): per block of episodes that started where
 evaluations start, the success share, the mean progress and the mean return; the episodes that
 started elsewhere (Mario's restarts) beside them, with where they started; and what ended the
-failures. For a run without a goal (Minitaur): per block, the mean return, episode length and info keys (metres walked), and the last
-periodic evaluations. For a PPO run, per block of rollouts (``rollouts.csv``): the same success
-shares beside the size of PPO's updates (entropy, approx KL, clip fraction), the learning rate and
-the entropy weight, to see what a change of settings did. It reads the same tables as ``main.py
-plot`` and works on a run that is training, interrupted or finished. TensorFlow-free.
+failures. For a run without a goal (Minitaur): per block, the mean return, episode length and info
+keys (metres walked), and the last periodic evaluations. For a PPO run, per block of rollouts
+(``rollouts.csv``): the same success shares beside the size of PPO's updates (entropy, approx KL,
+clip fraction), the learning rate and the entropy weight, to see what a change of settings did. It
+reads the same tables as ``main.py plot`` and works on a run that is training, interrupted or
+finished. TensorFlow-free.
 """
 from __future__ import annotations
 

@@ -9,9 +9,9 @@ from collections import deque
 import numpy as np
 import pytest
 
+from mario_ppo.curriculum import X_KEY, StepBack, lend_routes
 from mario_ppo.env import make_env
 from mario_ppo.experiment import EXPERIMENT
-from mario_ppo.curriculum import X_KEY, StepBack, lend_routes
 from rlcore.errors import UserError
 from rlcore.trainers import checkpoints
 from tests.mario_ppo.test_restarts import _restarts, _run_right_past
