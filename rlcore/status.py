@@ -149,14 +149,15 @@ def evaluation_lines(evals_csv: Path, last: int = 3) -> list[str]:
 
 
 def cause_line(experiment, span: pd.DataFrame, most: int = 5) -> str | None:
-    """The commonest causes of failure (``Experiment.cause_key``) in ``span``, as shares."""
+    """The commonest causes of failure (``Experiment.cause_key``) in ``span``, as shares. The span
+    holds every episode since the first of the blocks, restarted ones included, and says so."""
     key = experiment.cause_key
     if not key or key not in span or span[key].isna().all():
         return None
     causes = count_causes(span[[key]].to_dict("records"), key, experiment.cause_name)
     total = sum(n for _, n in causes)
     shares = ", ".join(f"{name} {n / total:.0%}" for name, n in causes[:most])
-    return f"{key} over these episodes ({total:,} failures): {shares}"
+    return f"{key} over all episodes since {int(span['episode'].iloc[0]):,} ({total:,} failures): {shares}"
 
 
 def _partial_between(df: pd.DataFrame, experiment, part: pd.DataFrame) -> pd.DataFrame | None:

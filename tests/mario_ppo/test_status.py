@@ -33,8 +33,8 @@ def test_status_counts_flags_per_block_of_full_episodes_and_restarts_beside_them
         assert line.endswith(f"| restarted {len(partial)} ({partial.success.sum()} flag_get)")
     span = df[df.episode >= full.episode.iloc[5]].killed_by.dropna()
     fell = (span == -1).mean()
-    assert lines[3] == (f"killed_by over these episodes ({len(span)} failures): fell {fell:.0%}, "
-                        f"grey Cheep-cheep {1 - fell:.0%}")
+    assert lines[3] == (f"killed_by over all episodes since {full.episode.iloc[5]:,} ({len(span)} failures): "
+                        f"fell {fell:.0%}, grey Cheep-cheep {1 - fell:.0%}")
     assert len(lines) == 4
 
 
