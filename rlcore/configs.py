@@ -132,7 +132,7 @@ class PPOConfig(RunBudget):
     gae_lambda: float = _h(0.97, "GAE lambda", UNIT)
     clip: float = _h(0.2, "PPO clip range of the probability ratio",
                      Allowed(low=0, high=1, low_open=True, high_open=True))
-    entropy_coef: float = _h(0.05, "entropy bonus weight", NON_NEGATIVE)
+    entropy_coef: float = _h(0.05, "entropy bonus weight (below 0: a penalty that sharpens pi)", FINITE)
     value_coef: float = _h(1.0, "value loss weight (the article adds it unweighted)", NON_NEGATIVE)
     value_loss: str = _h("mse", "mse: the squared error (the article); huber: 0.5 e^2 within 1, |e| - 0.5 "
                          "beyond (uvipen's PyTorch Mario), so a few large errors cannot swamp the "

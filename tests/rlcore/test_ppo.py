@@ -144,13 +144,36 @@ def test_update_raises_the_probability_of_advantaged_actions():
     assert after[:, 2].mean() > probs[:, 2].mean() + 0.05
 
 
-def test_sampling_follows_pi_and_logp_is_its_log():
-    tf.keras.utils.set_random_seed(0)
-    agent = PPOAgent(OBS, 5, CFG)
-    weights = agent.model.get_weights()  # a skewed policy: a uniform or mis-ordered draw would show
+def _skewed_agent(cfg):
+    """A PPO agent whose policy head's bias makes pi about (0.05, 0.5, 0.1, 0.3, 0.05) everywhere."""
+    agent = PPOAgent(OBS, 5, cfg)
+    weights = agent.model.get_weights()
     head = next(i for i, w in enumerate(weights) if w.shape == (5,))  # the policy head's bias
     weights[head] = np.log(np.array([0.05, 0.5, 0.1, 0.3, 0.05], np.float32))
     agent.model.set_weights(weights)
+    return agent
+
+
+@pytest.mark.parametrize("weight", [0.1, -0.1])
+def test_entropy_weight_sign_sets_where_the_entropy_goes(weight):
+    # no advantage and no value loss: only the entropy term moves pi, up for a bonus, down for a penalty
+    tf.keras.utils.set_random_seed(0)
+    cfg = dataclasses.replace(CFG, entropy_coef=weight, value_coef=0.0, epochs=5, lr=3e-3)
+    agent = _skewed_agent(cfg)  # a skewed start, so the entropy has room both ways
+    rng = np.random.default_rng(0)
+    obs, actions, logp, values, *_ = _rollout(rng, cfg)
+    zeros = np.zeros_like(values)
+    before, _ = agent.policy_and_values(obs.reshape(-1, *OBS))
+    agent.update(obs, actions, logp, zeros, zeros, zeros, zeros, zeros, rng)
+    after, _ = agent.policy_and_values(obs.reshape(-1, *OBS))
+    entropy = lambda p: -(p * np.log(p)).sum(axis=1).mean()  # noqa: E731
+    change = entropy(after) - entropy(before)
+    assert change * np.sign(weight) > 0.01
+
+
+def test_sampling_follows_pi_and_logp_is_its_log():
+    tf.keras.utils.set_random_seed(0)
+    agent = _skewed_agent(CFG)  # a skewed policy: a uniform or mis-ordered draw would show
     obs = np.random.default_rng(0).integers(0, 256, (1, *OBS), dtype=np.uint8)
     probs, _ = agent.policy_and_values(obs)
     assert probs[0].max() > 0.4
