@@ -21,7 +21,7 @@ BARS = {
 }
 # experiment, algo, folder under saved_networks/EXPERIMENT/ -> the success event, reached in 1 of 3
 # seeded runs
-SUCCESS_BARS = {("mario_ppo", "ppo", level): "flag_get" for level in ("1-1", "1-2", "1-3", "1-4", "2-1", "2-3", "2-4")}
+SUCCESS_BARS = {("mario_ppo", "ppo", level): "flag_get" for level in ("1-1", "1-2", "1-3", "1-4", "2-1", "2-2", "2-3", "2-4")}
 EPISODES = {"minitaur": 3}  # seeded episodes replayed by the test (1000 physics-heavy steps each)
 
 
