@@ -21,9 +21,11 @@ BARS = {
 }
 # the share of the recorded evaluation's episodes that lasted to the time limit (a walk, not a dash)
 FULL_LENGTH_SHARES = {("minitaur", "sac"): 0.5}
-# experiment, algo, folder under saved_networks/EXPERIMENT/ -> the success event, reached in 1 of 3
-# seeded runs
-SUCCESS_BARS = {("mario_ppo", "ppo", level): "flag_get" for level in ("1-1", "1-2", "1-3", "1-4", "2-1", "2-2", "2-3", "2-4")}
+# experiment, algo, folder under saved_networks/EXPERIMENT/ -> the success event and the least share of
+# the recorded evaluation's episodes that reached it (issue 14: 5 of 10 on every level, 8 of 10 on 1-1);
+# the test also replays 3 seeded episodes and wants the event in at least one
+SUCCESS_BARS = {("mario_ppo", "ppo", level): ("flag_get", 0.8 if level == "1-1" else 0.5)
+                for level in ("1-1", "1-2", "1-3", "1-4", "2-1", "2-2", "2-3", "2-4")}
 EPISODES = {"minitaur": 3}  # seeded episodes replayed by the test (1000 physics-heavy steps each)
 
 
@@ -69,10 +71,11 @@ def test_shipped_model_meets_its_bar(experiment, algo):
 def test_shipped_model_reaches_its_goal(experiment, algo, folder):
     from rlcore.evaluation import evaluate_success
 
-    key = SUCCESS_BARS[experiment, algo, folder]
+    key, share = SUCCESS_BARS[experiment, algo, folder]
     exp, meta, policy = load_policy(SHIPPED / experiment / folder, experiment, algo)
     assert meta["command"].startswith(f"python main.py train {experiment} {algo}")
-    assert meta["evaluation"]["success_share"] > 0
+    assert meta["evaluation"]["episodes"] == exp.eval_episodes
+    assert meta["evaluation"]["success_share"] >= share
     records = evaluate_success(policy.make_env, policy.sample, 3, exp.eval_seed_base, key,
                                exp.progress_key, progress=False, stop_at_success=True)
     assert any(r["success"] for r in records), records
