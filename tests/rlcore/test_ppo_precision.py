@@ -77,7 +77,7 @@ def test_a_bfloat16_model_saves_and_loads_as_trained(tmp_path):
 
 
 @pytest.mark.usefixtures("toy_experiments")
-def test_a_bfloat16_run_trains_and_notes_a_cpu_without_amx(tmp_path, monkeypatch, capsys):
+def test_a_bfloat16_run_trains_and_notes_a_cpu_without_bfloat16_units(tmp_path, monkeypatch, capsys):
     from rlcore.trainers import ppo as ppo_trainer
     from tests import toy
 
