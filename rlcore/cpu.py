@@ -50,6 +50,6 @@ def bfloat16_note(precision: str, flags: set[str] | None) -> str | None:
     """One console line when a run computes in bfloat16 on a CPU where that was never measured faster."""
     if precision != "bfloat16" or flags is None or flags.intersection(BFLOAT16_MATMUL):
         return None
-    return (f"note: --precision bfloat16 was measured faster only on CPUs with {' or '.join(BFLOAT16_MATMUL)}, "
-            "which this one lacks; `python benchmarks/mario.py --skip-env --skip-pool` compares both precisions here, "
-            "and a resume with --precision float32 switches back")
+    return (f"note: --precision bfloat16 was measured faster only on CPUs with "
+            f"{' or '.join(BFLOAT16_MATMUL)}, which this one lacks; `python benchmarks/mario.py --skip-env "
+            "--skip-pool` compares both precisions here, and a resume with --precision float32 switches back")
