@@ -53,8 +53,8 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
     train.add_argument("--episodes", type=COUNT, default=None, help="episode budget (max_episodes)")
     train.add_argument("--steps", type=COUNT, default=None, help="env step budget (max_env_steps)")
     train.add_argument("--seed", type=SEED, default=0,
-                       help="seeds numpy, TensorFlow and the env (default 0); training env seeds stay "
-                            "below 1,000,000, apart from the evaluation seeds")
+                       help=f"0 to {MAX_RUN_SEED}: seeds numpy, TensorFlow and the envs (default 0); each run "
+                            "seed owns its own training env seeds, all below the evaluation seeds")
     train.add_argument("--wandb", default="auto", choices=["auto", "online", "offline", "off"],
                        help="auto = online when logged in, else offline (default auto)")
     train.add_argument("--resume", nargs="?", const="latest", default=None, metavar="RUN_DIR",
@@ -99,7 +99,7 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
     sweep = sub.add_parser(
         "sweep", help="many runs (seeds x grid values) on Ray Tune, locally or on a cluster",
         description="One trial per combination of --seeds and --grid values; each trial is an ordinary "
-                    "run folder under sweeps/NAME/ (evaluate, render and plot work on it). A trial "
+                    "run folder under DIR/NAME/ (evaluate, render and plot work on it). A trial "
                     "restarted after a crash resumes from its checkpoint; Ctrl-C or SIGTERM stops every trial "
                     "at a checkpoint; --resume continues and skips finished trials.")
     sweep.add_argument("experiment")
@@ -119,7 +119,10 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
     sweep.add_argument("--num-cpus", type=COUNT, default=None,
                        help="CPUs of the local Ray instance (default: all of this machine's)")
     sweep.add_argument("--name", type=folder_name, default=None,
-                       help="sweep folder name, under sweeps/ (default EXPERIMENT__ALGO)")
+                       help="sweep folder name, under --dir (default EXPERIMENT__ALGO)")
+    sweep.add_argument("--dir", default="sweeps", metavar="DIR",
+                       help="the folder that holds sweep folders (default sweeps, which git ignores; "
+                            "long_runs/sweeps for a sweep that outlives a session)")
     sweep.add_argument("--address", default=None,
                        help="join a running Ray cluster (e.g. 10.0.0.5:6379) instead of starting local Ray")
     sweep.add_argument("--resume", action="store_true", help="continue the sweep NAME; finished trials are kept")

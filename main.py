@@ -231,12 +231,12 @@ def cmd_status(args) -> int:
 
 def cmd_sweep(args) -> int:
     from rlcore.experiment import get_experiment
-    from rlcore.sweep import SWEEPS_DIR, Sweep, parse_grid, parse_seeds, run_sweep
+    from rlcore.sweep import Sweep, parse_grid, parse_seeds, run_sweep
 
     exp = get_experiment(args.experiment)
     base = exp.preset(args.algo, args.preset)
     name = args.name or f"{args.experiment}__{args.algo}"
-    folder = (SWEEPS_DIR / name).resolve()
+    folder = (Path(args.dir) / name).resolve()
     if args.resume:
         sweep = Sweep.load(folder)
         if (sweep.experiment, sweep.algo) != (args.experiment, args.algo):

@@ -32,7 +32,6 @@ from rlcore.atomic import writable_folder, write_json
 from rlcore.errors import UserError
 from rlcore.trainers.stopping import STOP_SIGNALS
 
-SWEEPS_DIR = Path("sweeps")
 SWEEP_FILE = "sweep.json"
 STOP_FILE = "STOP"
 

@@ -186,7 +186,25 @@ def test_every_experiment_evaluates_above_the_training_seeds():
 
 
 def test_seed_zero_keeps_the_env_seeds_of_the_shipped_runs():
-    assert [training_env_seed(0, i) for i in range(5)] == [0, 1, 2, 3, 4]
+    # the shipped runs reseeded at resumes up to episode ~73,000 (Mario 1-3)
+    assert [training_env_seed(0, i) for i in (0, 1, 2, 3, 4, 73_078, 99_999)] == [0, 1, 2, 3, 4, 73_078, 99_999]
+
+
+def test_no_two_run_seeds_share_a_training_env_seed():
+    """Every run seed's block, over every index a run can reach, is its own and below the evaluation
+    seeds (before, --seed 1000 repeated --seed 0, and seed 1 met seed 0's seeds after 1,000 episodes)."""
+    from rlcore.seeding import seed_block
+
+    seen = set()
+    for run_seed in range(MAX_RUN_SEED + 1):
+        block = seed_block(run_seed)
+        reached = {training_env_seed(run_seed, i) for i in (0, 1, 999, 1000, 1001, 73_078, 10**9)}
+        assert reached <= set(block)
+        assert seen.isdisjoint(block), run_seed
+        seen.update(block)
+    assert max(seen) < TRAINING_SEED_SPAN
+    with pytest.raises(ValueError):  # a seed past the blocks would have to share one
+        training_env_seed(MAX_RUN_SEED + 1, 0)
 
 
 NOISE = ("oneDNN", "cuInit", "cuda", "absl", "argv[0]", "pybullet build time", "HDF5")
