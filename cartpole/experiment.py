@@ -11,7 +11,7 @@ from functools import partial
 import gymnasium as gym
 
 from rlcore.configs import A2CConfig, DQNConfig
-from rlcore.experiment import AlgoSpec, Experiment
+from rlcore.experiment import AlgoSpec, Bar, Experiment
 
 
 def make_env(render_mode: str | None = None, max_episode_steps: int | None = None,
@@ -59,6 +59,8 @@ def _experiment(name: str, env_id: str, cap: int) -> Experiment:
             "a2c": AlgoSpec("a2c", "a2c", "A2C, 8 envs, 5-step", a2c_presets()),
         },
         score_label="duration (steps)",
+        bars={algo: Bar("mean", float(cap), f"the episode cap: every greedy episode balances for all {cap} steps")
+              for algo in ("dqn", "a2c")},
     )
 
 

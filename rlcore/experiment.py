@@ -6,7 +6,7 @@ are imported lazily by module path.
 from __future__ import annotations
 
 import importlib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import partial
 from typing import Callable
 
@@ -30,6 +30,36 @@ class AlgoSpec:
     description: str
     presets: dict  # preset name -> config dataclass instance
     default_preset: str = "default"
+
+
+@dataclass(frozen=True)
+class Bar:
+    """What a shipped model must reach in its evaluation on unseen seeds, and why that number.
+
+    ``metric``: ``mean`` (mean return of the greedy or mean-action policy) or ``success_share``
+    (share of episodes reaching the success event, actions sampled from pi). ``full_length_share``:
+    the least share of episodes that must last to the time limit (a walk, not a dash and a fall).
+    """
+    metric: str
+    value: float
+    reason: str
+    full_length_share: float | None = None
+
+    def met_by(self, evaluation: dict) -> bool:
+        """Whether a recorded evaluation (meta.json's ``evaluation``) clears the bar."""
+        if evaluation.get(self.metric) is None or evaluation[self.metric] < self.value:
+            return False
+        return self.full_length_share is None or evaluation.get("time_limit_share", 0.0) >= self.full_length_share
+
+    def describe(self) -> str:
+        """``mean return >= 230`` or ``flag in >= 50 % of episodes``, for cards and tables."""
+        if self.metric == "success_share":
+            text = f"success in >= {self.value:.0%} of episodes"
+        else:
+            text = f"mean return >= {self.value:g}"
+        if self.full_length_share is not None:
+            text += f", >= {self.full_length_share:.0%} of episodes full length"
+        return text
 
 
 @dataclass(frozen=True)
@@ -82,6 +112,9 @@ class Experiment:
     plot_prefix: str = ""  # the plot files' name prefix (empty: the experiment's name)
     video_fps: int = 30
     episodes_per_video: int = 1
+    # the bar each shipped model must clear, by model folder name (the algorithm, or Mario's level):
+    # the one place it is written; tests, cards and the README read it here
+    bars: dict[str, Bar] = field(default_factory=dict)
 
     def training_env_factory(self, config) -> Callable:
         """:meth:`env_factory` plus the training-only fields (``train_env_fields``)."""
@@ -99,6 +132,10 @@ class Experiment:
         if config is not None:
             kwargs.setdefault("max_episode_steps", config.max_episode_steps or None)
         return partial(self.make_env, **kwargs)
+
+    def bar(self, model: str) -> Bar | None:
+        """The bar of the shipped model ``model`` (an algorithm, or Mario's ``1-1``), if it has one."""
+        return self.bars.get(model)
 
     def algo(self, name: str) -> AlgoSpec:
         if name not in self.algos:
