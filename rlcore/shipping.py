@@ -93,8 +93,11 @@ def evaluate_into_meta(model_dir: Path, episodes: int, seed_base: int | None = N
     from rlcore.atomic import write_json
     from rlcore.policies import load_policy
 
+    from rlcore.machine import this_machine
+
     exp, meta, policy = load_policy(model_dir)
     meta["evaluation"], line = run_evaluation(exp, policy, episodes, seed_base)
+    meta["evaluation"]["machine"] = this_machine()  # where these episodes replay exactly (rlcore.machine)
     write_json(model_dir / "meta.json", meta)
     print(f"evaluation (unseen seeds): {line}")
     return meta

@@ -1,90 +1,149 @@
-"""Every shipped model loads from its .h5, clears its bar on seeded episodes, and carries its story."""
+"""Every shipped model loads from its .h5, clears its bar, still plays, and carries its story.
+
+Two ways to check that a model still plays, chosen by :func:`rlcore.machine.replays_exactly`:
+
+- where its evaluation was recorded (the same CPU and package versions), its first seeded episodes
+  must repeat the record exactly;
+- anywhere else they need not: TensorFlow's oneDNN orders float sums by the CPU's vector units, so a
+  greedy argmax or a sampled action can flip and an episode take another course (the shipped Minitaur
+  model returned 22.86 on an Intel Xeon where an AMD EPYC recorded 22.48). There the test plays live
+  episodes from the same unseen seeds and asserts what holds on every machine: the live episodes give
+  no evidence, at the 0.1 % level, that the model falls short of its bar.
+"""
+import math
 from pathlib import Path
 
 import imageio.v3 as iio
 import numpy as np
 import pytest
 
-from rlcore.evaluation import evaluate
+from rlcore import machine
+from rlcore.evaluation import evaluate, evaluate_success
 from rlcore.experiment import experiment_names, get_experiment
 from rlcore.policies import load_policy
 from rlcore.video import record_video
 
 SHIPPED = Path(__file__).resolve().parents[1] / "saved_networks"
-# SPEC.md "our bar", greedy mean return
-BARS = {
-    ("lunar_lander", "dqn"): 230.0, ("lunar_lander", "ddqn"): 230.0,
-    ("lunar_lander", "dueling_dqn"): 230.0, ("lunar_lander", "dueling_ddqn"): 230.0,
-    ("lunar_lander", "a2c"): 200.0,
-    ("cartpole", "dqn"): 500.0, ("cartpole", "a2c"): 500.0, ("cartpole_v0", "a2c"): 200.0,
-    ("minitaur", "sac"): 11.3,  # RL Zoo's published PPO2 result (issue 17); article 004's peak was 0.85
-}
-# the share of the recorded evaluation's episodes that lasted to the time limit (a walk, not a dash)
-FULL_LENGTH_SHARES = {("minitaur", "sac"): 0.5}
-# experiment, algo, folder under saved_networks/EXPERIMENT/ -> the success event and the least share of
-# the recorded evaluation's episodes that reached it (issue 14: 5 of 10 on every level, 8 of 10 on 1-1);
-# the test also replays 3 seeded episodes and wants the event in at least one
-SUCCESS_BARS = {("mario_ppo", "ppo", level): ("flag_get", 0.8 if level == "1-1" else 0.5)
-                for level in ("1-1", "1-2", "1-3", "1-4", "2-1", "2-2", "2-3", "2-4")}
-EPISODES = {"minitaur": 3}  # seeded episodes replayed by the test (1000 physics-heavy steps each)
+Z_ONE_SIDED = 3.09  # the standard normal's 99.9th percentile: a 0.1 % chance of failing a model at its bar
+# live episodes played where a record cannot replay: enough that a model clearly below its bar fails
+# (LunarLander's spread is ~20-90 points, so 20 episodes bound the mean within ~45-60 of the bar)
+LIVE_EPISODES = {"lunar_lander": 20, "cartpole": 5, "cartpole_v0": 5, "minitaur": 3}
+REPLAYED_EPISODES = {"minitaur": 3}  # recorded episodes replayed exactly on the recording machine (default 5)
+# a success-scored model (Mario, bar >= 50 % flags) plays sampled episodes until one reaches the flag:
+# with a true share of at least 1/2, ten misses in a row have a chance below 0.1 %
+SUCCESS_TRIES = 10
 
 
-def test_every_bar_names_a_registered_algorithm():
-    for experiment, algo in BARS:
-        get_experiment(experiment).algo(algo)
-
-
-def test_no_model_is_shipped_without_a_bar():
+def shipped_models() -> list[tuple[str, str, str]]:
+    """(experiment, algorithm, model folder name) of every model under saved_networks/."""
+    found = []
     for name in experiment_names():
-        for algo in get_experiment(name).algos:
-            if (SHIPPED / name / algo / "meta.json").exists():
-                assert (name, algo) in BARS
-            if get_experiment(name).ship_by:
-                for meta in (SHIPPED / name).glob("*/meta.json"):
-                    assert (name, algo, meta.parent.name) in SUCCESS_BARS, meta
+        exp = get_experiment(name)
+        for meta in sorted((SHIPPED / name).glob("*/meta.json")):
+            folder = meta.parent.name
+            algos = [folder] if folder in exp.algos else list(exp.algos)  # Mario: a level, one algo
+            found.append((name, algos[0], folder))
+    return found
 
 
-@pytest.mark.parametrize("experiment, algo", sorted(BARS))
-def test_shipped_model_meets_its_bar(experiment, algo):
-    bar = BARS[experiment, algo]
-    exp, meta, policy = load_policy(SHIPPED / experiment / algo, experiment, algo)
-    # the recorded story: our own training command, seed, budget, time, a 100-episode evaluation
+MODELS = shipped_models()
+
+
+def test_every_shipped_model_has_a_bar_and_every_bar_a_model():
+    shipped = {(experiment, folder) for experiment, _, folder in MODELS}
+    for experiment, _, folder in MODELS:
+        assert get_experiment(experiment).bar(folder) is not None, (experiment, folder)
+    for name in experiment_names():
+        exp = get_experiment(name)
+        for folder in exp.bars:
+            assert folder in exp.algos or exp.ship_by, (name, folder)
+            if folder in exp.algos:
+                assert (name, folder) in shipped, (name, folder)
+    assert len(MODELS) == 17
+
+
+def still_plays(exp, meta: dict, policy, folder: str) -> str:
+    """Check that the model plays as its record says; returns which check ran: "replay" or "bar"."""
+    if machine.replays_exactly(machine.recorded_machine(meta)):
+        _replay_exactly(exp, meta, policy)
+        return "replay"
+    _clears_bar_live(exp, meta, policy, folder)
+    return "bar"
+
+
+def _replay_exactly(exp, meta, policy) -> None:
+    recorded = meta["evaluation"]["per_episode"]
+    if exp.success_key:
+        records = evaluate_success(policy.make_env, policy.sample, 3, exp.eval_seed_base, exp.success_key,
+                                   exp.progress_key, progress=False, stop_at_success=True)
+        for got, want in zip(records, recorded):
+            assert (got["seed"], got["success"], got["length"]) == (want["seed"], want["success"], want["length"])
+            assert got[exp.progress_key] == want[exp.progress_key]
+        return
+    n = REPLAYED_EPISODES.get(exp.name, 5)
+    returns = evaluate(exp, policy, episodes=n, progress=False, make_env=policy.make_env)
+    assert [r["seed"] for r in recorded[:n]] == list(range(exp.eval_seed_base, exp.eval_seed_base + n))
+    np.testing.assert_allclose(returns, [r["return"] for r in recorded[:n]], rtol=1e-5)
+
+
+def _clears_bar_live(exp, meta, policy, folder: str) -> None:
+    bar = exp.bar(folder)
+    if exp.success_key:
+        records = evaluate_success(policy.make_env, policy.sample, SUCCESS_TRIES, exp.eval_seed_base,
+                                   exp.success_key, exp.progress_key, progress=False, stop_at_success=True)
+        assert records[-1]["success"], f"{exp.name} {folder}: no {exp.success_key} in {len(records)} episodes"
+        return
+    n = LIVE_EPISODES[exp.name]
+    returns = evaluate(exp, policy, episodes=n, progress=False, make_env=policy.make_env)
+    recorded_std = meta["evaluation"]["std"]
+    # the larger of the recorded and the live spread: a cap-reaching model records 0, and a few live
+    # episodes can understate a wide spread
+    spread = max(recorded_std, float(returns.std(ddof=1)))
+    floor = bar.value - Z_ONE_SIDED * spread / math.sqrt(n)
+    assert returns.mean() >= floor, (f"{exp.name} {folder}: live mean {returns.mean():.1f} over {n} episodes "
+                                     f"is below {floor:.1f} (bar {bar.value:g}): {returns.round(1)}")
+
+
+@pytest.mark.parametrize("experiment, algo, folder", MODELS)
+def test_shipped_model_meets_its_bar(experiment, algo, folder):
+    exp, meta, policy = load_policy(SHIPPED / experiment / folder, experiment, algo)
+    bar = exp.bar(folder)
+    # the recorded story: our own training command, seed, budget, time, an evaluation on unseen seeds
     assert meta["command"].startswith(f"python main.py train {experiment} {algo}")
     for key in ("seed", "env_steps", "episodes", "wall_seconds", "config", "versions"):
         assert key in meta, key
-    assert meta["evaluation"]["episodes"] == exp.eval_episodes
-    assert meta["evaluation"]["mean"] >= bar
-    if (experiment, algo) in FULL_LENGTH_SHARES:
-        assert meta["evaluation"]["time_limit_share"] >= FULL_LENGTH_SHARES[experiment, algo]
-    # and it still plays: seeded episodes from the unseen-seed range, each as its record says
-    returns = evaluate(exp, policy, episodes=EPISODES.get(experiment, 5), progress=False)
-    assert returns.mean() >= bar, f"{experiment} {algo}: {returns.round(1)}"
-    recorded = meta["evaluation"]["per_episode"]
+    evaluation = meta["evaluation"]
+    assert evaluation["episodes"] == exp.eval_episodes
+    assert bar.met_by(evaluation), (bar, {k: v for k, v in evaluation.items() if k != "per_episode"})
+    recorded = evaluation["per_episode"]
     assert len(recorded) == exp.eval_episodes
-    assert np.mean([r["return"] for r in recorded]) == pytest.approx(meta["evaluation"]["mean"], abs=0.01)
-    assert [r["seed"] for r in recorded[:len(returns)]] == list(range(exp.eval_seed_base,
-                                                                        exp.eval_seed_base + len(returns)))
-    np.testing.assert_allclose(returns, [r["return"] for r in recorded[:len(returns)]], rtol=1e-5)
+    if exp.success_key:
+        assert np.mean([r["success"] for r in recorded]) == pytest.approx(evaluation["success_share"])
+    else:
+        assert np.mean([r["return"] for r in recorded]) == pytest.approx(evaluation["mean"], abs=0.01)
+    still_plays(exp, meta, policy, folder)
 
 
-@pytest.mark.parametrize("experiment, algo, folder", sorted(SUCCESS_BARS))
-def test_shipped_model_reaches_its_goal(experiment, algo, folder):
-    from rlcore.evaluation import evaluate_success
-
-    key, share = SUCCESS_BARS[experiment, algo, folder]
+@pytest.mark.parametrize("experiment, algo, folder", [("lunar_lander", "dqn", "dqn"),
+                                                      ("mario_ppo", "ppo", "1-1")])
+def test_on_another_cpu_a_model_is_held_to_its_bar_not_to_its_record(experiment, algo, folder, monkeypatch):
+    """This machine recorded most models, so the path other CPUs take is proven by pretending to be one."""
     exp, meta, policy = load_policy(SHIPPED / experiment / folder, experiment, algo)
-    assert meta["command"].startswith(f"python main.py train {experiment} {algo}")
-    assert meta["evaluation"]["episodes"] == exp.eval_episodes
-    assert meta["evaluation"]["success_share"] >= share
-    records = evaluate_success(policy.make_env, policy.sample, 3, exp.eval_seed_base, key,
-                               exp.progress_key, progress=False, stop_at_success=True)
-    assert any(r["success"] for r in records), records
-    # each episode replays its record (seeded env and seeded action draws)
-    recorded = meta["evaluation"]["per_episode"]
-    assert np.mean([r["success"] for r in recorded]) == pytest.approx(meta["evaluation"]["success_share"])
-    for got, want in zip(records, recorded):
-        assert (got["seed"], got["success"], got["length"]) == (want["seed"], want["success"], want["length"])
-        assert got[exp.progress_key] == want[exp.progress_key]
+    other = {"cpu": "Another CPU (avx2 fma)", "versions": machine.package_versions()}
+    monkeypatch.setattr(machine, "this_machine", lambda: other)
+    assert still_plays(exp, meta, policy, folder) == "bar"
+
+
+def test_a_record_replays_exactly_only_on_its_own_cpu_and_versions():
+    here = {"cpu": "AMD EPYC (avx2 fma avx512f)", "versions": {"tensorflow": "2.21.0", "numpy": "2.5.5"}}
+    assert machine.replays_exactly(here, here)
+    assert not machine.replays_exactly({**here, "cpu": "Intel(R) Xeon(R) (avx2 fma avx512f amx_tile)"}, here)
+    assert not machine.replays_exactly({**here, "versions": {"tensorflow": "2.20.0"}}, here)
+    assert not machine.replays_exactly(None, here)  # a record that does not say where it was made
+    # the evaluation's own machine wins over the training run's
+    meta = {"cpu": "A", "versions": {}, "evaluation": {"machine": {"cpu": "B", "versions": {}}}}
+    assert machine.recorded_machine(meta)["cpu"] == "B"
+    assert machine.recorded_machine({"evaluation": {}}) is None
 
 
 def test_render_of_a_shipped_model_is_a_decodable_mp4(tmp_path):

@@ -2,27 +2,13 @@
 (what the run was, the commands that made it, its counters, and the package versions)."""
 from __future__ import annotations
 
-import platform
 from datetime import datetime, timezone
 from pathlib import Path
 
 from rlcore.atomic import write_json
 from rlcore.cpu import cpu_description
+from rlcore.machine import package_versions
 from rlcore.plotting import plot_run
-
-
-def package_versions() -> dict:
-    """Versions of Python and of the packages a run's numbers depend on (those installed)."""
-    from importlib.metadata import PackageNotFoundError, version
-
-    found = {"python": platform.python_version()}
-    for dist in ("tensorflow", "tensorflow-cpu", "keras", "gymnasium", "numpy", "box2d", "nes-py",
-                 "gym-super-mario-bros", "pybullet"):
-        try:
-            found[dist] = version(dist)
-        except PackageNotFoundError:
-            pass
-    return found
 
 
 def write_model_folder(run_dir: Path, experiment, describe: dict, save_models, record: dict) -> Path:

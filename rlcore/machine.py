@@ -1,0 +1,61 @@
+"""The machine a number was computed on, and whether a record replays exactly here.
+
+A seed repeats a run or an evaluation bit for bit only on the same CPU family and package versions:
+TensorFlow's oneDNN kernels order float sums by the CPU's vector units, so on another CPU a greedy
+argmax or a sampled action can flip and an episode take another course (seen: the shipped Minitaur
+model's first episodes returned 22.86 on an Intel Xeon with AMX against 22.48 recorded on an AMD
+EPYC). A record is replayed exactly only where :func:`replays_exactly` says so; elsewhere callers
+check what holds on every machine (a bar, a statistical bound).
+"""
+from __future__ import annotations
+
+import platform
+
+from rlcore.cpu import cpu_description
+
+# the distributions whose versions a run's or an evaluation's numbers depend on (those installed)
+NUMERIC_PACKAGES = ("tensorflow", "tensorflow-cpu", "keras", "gymnasium", "numpy", "box2d", "nes-py",
+                    "gym-super-mario-bros", "pybullet")
+
+
+def package_versions() -> dict:
+    """Versions of Python and of the packages a run's numbers depend on (those installed)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    found = {"python": platform.python_version()}
+    for dist in NUMERIC_PACKAGES:
+        try:
+            found[dist] = version(dist)
+        except PackageNotFoundError:
+            pass
+    return found
+
+
+def this_machine() -> dict:
+    """``{"cpu": ..., "versions": {...}}`` of this process, as meta.json records them."""
+    return {"cpu": cpu_description(), "versions": package_versions()}
+
+
+def recorded_machine(meta: dict) -> dict | None:
+    """Where a model folder's evaluation was computed: the evaluation's own ``machine`` (written since
+    2026-11-27), else the training run's ``cpu`` and ``versions`` (the final evaluation ran in the same
+    process); None when the record does not say which CPU (older models)."""
+    machine = (meta.get("evaluation") or {}).get("machine")
+    if machine:
+        return machine
+    if meta.get("cpu") and meta.get("versions"):
+        return {"cpu": meta["cpu"], "versions": meta["versions"]}
+    return None
+
+
+def replays_exactly(recorded: dict | None, here: dict | None = None) -> bool:
+    """Whether a record made on ``recorded`` can be expected to repeat bit for bit on ``here`` (default
+    this machine): the same CPU description (name and vector units) and every recorded package at the
+    same version. Unknown is no."""
+    if not recorded:
+        return False
+    here = this_machine() if here is None else here
+    if recorded.get("cpu") != here.get("cpu"):
+        return False
+    versions = here.get("versions", {})
+    return all(versions.get(name) == value for name, value in recorded.get("versions", {}).items())
