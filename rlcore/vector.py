@@ -10,10 +10,15 @@ modules, so workers start without importing TensorFlow.
 
 A worker that dies or stops answering raises :class:`EnvWorkerDied` naming the worker, and the
 pool closes the rest: no hang, no process left behind.
+
+Workers ignore SIGINT and SIGTERM. Ctrl-C in a terminal, GNU ``timeout`` and job schedulers signal
+the whole process group; the trainer in the parent handles the signal (it stops at its next safe
+point and writes a checkpoint) and then closes the pool, so the workers must still answer until then.
 """
 from __future__ import annotations
 
 import multiprocessing
+import signal
 import time
 import warnings
 from typing import Callable, Sequence
@@ -28,6 +33,18 @@ VEC_MODES = ("inline", "processes")
 
 class EnvWorkerDied(UserError):
     """An env worker process exited or stopped answering."""
+
+
+class IgnoringStopSignals:
+    """A picklable env factory that first makes its (worker) process ignore SIGINT and SIGTERM."""
+
+    def __init__(self, make_env: Callable[[], gym.Env]):
+        self.make_env = make_env
+
+    def __call__(self) -> gym.Env:
+        for number in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(number, signal.SIG_IGN)
+        return self.make_env()
 
 
 def _start_method() -> str:
@@ -58,7 +75,8 @@ class EnvPool:
         self.mode, self.step_timeout = mode, step_timeout
         autoreset = gym.vector.AutoresetMode.SAME_STEP
         if mode == "processes":
-            self.envs = gym.vector.AsyncVectorEnv(env_fns, context=_start_method(), daemon=True,
+            self.envs = gym.vector.AsyncVectorEnv([IgnoringStopSignals(fn) for fn in env_fns],
+                                                  context=_start_method(), daemon=True,
                                                   autoreset_mode=autoreset)
         else:
             self.envs = gym.vector.SyncVectorEnv(env_fns, autoreset_mode=autoreset)
