@@ -43,8 +43,11 @@ def build_spec(experiment: str, algo: str, *, preset: str | None = None, seed: i
 def run_training(spec: RunSpec, on_progress: Callable[[dict, str], None] | None = None) -> Path:
     """Train ``spec`` to its end; return the model folder. ``on_progress(row, table)`` sees every row
     the run logs as it is logged. Ctrl-C (or ``spec.stop_file``) raises ``Interrupted`` after the
-    checkpoint is written."""
+    checkpoint is written. A run folder that another process writes is refused (``RunFolderBusy``)."""
+    from rlcore.run_lock import hold_run_folder
+
     if on_progress is not None:
         spec.on_progress = on_progress
     trainer = importlib.import_module(f"rlcore.trainers.{spec.kind}")
-    return trainer.train(spec)
+    with hold_run_folder(spec.run_dir):  # one writer per run folder (a second one is refused here)
+        return trainer.train(spec)

@@ -148,9 +148,15 @@ def run_trial(trial: dict, sweep: dict, modules: dict, report) -> dict:
     meta_path = run_dir / "model" / "meta.json"
     if meta_path.is_file():  # finished before: not run again
         return final_metrics(json.loads(meta_path.read_text()), skipped=True)
-    run_dir.mkdir(parents=True, exist_ok=True)
-    (run_dir / "worker.pid").write_text(f"{os.getpid()}\n")
+    from rlcore.run_lock import hold_run_folder
 
+    with hold_run_folder(run_dir):  # one writer: a trial restarted while its old worker lives is refused
+        (run_dir / "worker.pid").write_text(f"{os.getpid()}\n")
+        return _train_trial(trial, sweep, run_dir, report)
+
+
+def _train_trial(trial: dict, sweep: Sweep, run_dir: Path, report) -> dict:
+    """The trial's run in ``run_dir``, resumed where a checkpoint exists; its final metrics."""
     from rlcore import shipping
     from rlcore.run import build_spec, run_training
     from rlcore.trainers.stopping import Interrupted

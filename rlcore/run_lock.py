@@ -1,0 +1,60 @@
+"""One writer per run folder.
+
+A process that trains or resumes a run folder holds an advisory lock (``flock``) on its ``.lock``
+file for as long as it writes there. The kernel drops the lock when the process ends, however it
+ends (``kill -9`` included), so a lock is never stale: a Ray trial restarted after its worker died
+takes it again. A second writer is refused in one line naming the folder and the holder's pid,
+before it has written anything there.
+"""
+from __future__ import annotations
+
+import contextlib
+import errno
+import fcntl
+import os
+from pathlib import Path
+from typing import Iterator
+
+from rlcore.errors import UserError
+
+LOCK_FILE = ".lock"
+_held: dict[Path, list] = {}  # folder -> [fd, depth]: a process may re-enter its own lock
+
+
+class RunFolderBusy(UserError):
+    """Another process writes the run folder."""
+
+
+@contextlib.contextmanager
+def hold_run_folder(run_dir: str | os.PathLike) -> Iterator[Path]:
+    """Hold the run folder's lock for the duration of the block (creating the folder if needed)."""
+    folder = Path(run_dir).resolve()
+    if folder in _held:
+        _held[folder][1] += 1
+        try:
+            yield folder
+        finally:
+            _held[folder][1] -= 1
+        return
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        fd = os.open(folder / LOCK_FILE, os.O_RDWR | os.O_CREAT, 0o644)
+    except OSError as exc:
+        raise UserError(f"run folder {folder}: cannot write there ({exc.strerror or exc})") from None
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError as exc:
+        holder = os.pread(fd, 32, 0).decode(errors="replace").strip() or "unknown"
+        os.close(fd)
+        if exc.errno not in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
+            raise UserError(f"run folder {folder}: cannot lock it ({exc.strerror})") from None
+        raise RunFolderBusy(f"run folder {folder} is being written by process {holder}; wait for it to end "
+                            f"(or stop it: kill {holder}), then --resume it") from None
+    try:
+        os.ftruncate(fd, 0)
+        os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)  # who holds it, for the message above
+        _held[folder] = [fd, 1]
+        yield folder
+    finally:
+        _held.pop(folder, None)
+        os.close(fd)  # closing the descriptor releases the lock

@@ -1,0 +1,66 @@
+"""One writer per run folder: a second process that would train or resume a folder another process
+writes is refused in one line naming the folder and the holder's pid, and changes nothing there; the
+lock dies with its holder, so after `kill -9` the run resumes."""
+import hashlib
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+from rlcore.run_lock import RunFolderBusy, hold_run_folder
+
+ROOT = Path(__file__).resolve().parents[1]
+QUICK = ["--wandb", "off", "--no-progress", "--final-eval-episodes", "0"]
+
+
+def main_py(*argv: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "main.py", *argv], cwd=ROOT, capture_output=True, text=True,
+                          timeout=300)
+
+
+def hold_elsewhere(folder: Path) -> subprocess.Popen:
+    """Another process that holds the folder's lock until killed."""
+    code = ("import sys, time; from rlcore.run_lock import hold_run_folder\n"
+            "with hold_run_folder(sys.argv[1]):\n    print('held', flush=True); time.sleep(600)")
+    holder = subprocess.Popen([sys.executable, "-c", code, str(folder)], cwd=ROOT, stdout=subprocess.PIPE,
+                              text=True)
+    assert holder.stdout.readline().strip() == "held"
+    return holder
+
+
+def fingerprint(folder: Path) -> dict:
+    return {p.relative_to(folder).as_posix(): hashlib.sha256(p.read_bytes()).hexdigest()
+            for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+def test_a_second_writer_is_refused_and_a_killed_holder_leaves_no_stale_lock(tmp_path):
+    run_dir = tmp_path / "run"
+    first = main_py("train", "cartpole", "dqn", "--episodes", "2", "--run-dir", str(run_dir), *QUICK)
+    assert first.returncode == 0, first.stderr
+    holder = hold_elsewhere(run_dir)
+    before = fingerprint(run_dir)
+    try:
+        second = main_py("train", "cartpole", "dqn", "--resume", str(run_dir), "--episodes", "4", *QUICK)
+        assert second.returncode == 2
+        lines = second.stderr.strip().splitlines()
+        assert len(lines) == 1 and str(run_dir.resolve()) in lines[0] and str(holder.pid) in lines[0], lines
+        assert fingerprint(run_dir) == before  # nothing written, nothing dropped
+    finally:
+        holder.send_signal(signal.SIGKILL)
+        holder.wait()
+    third = main_py("train", "cartpole", "dqn", "--resume", str(run_dir), "--episodes", "4", *QUICK)
+    assert third.returncode == 0, third.stderr
+
+
+def test_a_process_may_reenter_its_own_lock_and_another_may_not(tmp_path):
+    with hold_run_folder(tmp_path / "run") as folder:
+        with hold_run_folder(folder):  # a sweep trial holds it, then run_training takes it again
+            pass
+        holder_line = (folder / ".lock").read_text().strip()
+        assert holder_line.isdigit()
+        other = subprocess.run([sys.executable, "-c", "import sys; from rlcore.run_lock import hold_run_folder\n"
+                                "with hold_run_folder(sys.argv[1]): pass", str(folder)],
+                               cwd=ROOT, capture_output=True, text=True)
+        assert other.returncode != 0 and "RunFolderBusy" in other.stderr
+    with hold_run_folder(tmp_path / "run"):  # released at the end of the block: taken again
+        pass
