@@ -20,9 +20,20 @@ from tests.test_cli import run
 BUDGET = {"max_episodes": 40, "stop_score": 99.0, "checkpoint_every": 10}
 
 
+def _ray_pids() -> set[str]:
+    out = subprocess.run(["pgrep", "-f", "raylet|gcs_server|ray::"], capture_output=True, text=True).stdout
+    return set(out.split())
+
+
+# Ray processes that were running before these tests started theirs (a developer's own sweep, say):
+# the tests look at their own Ray only
+OTHERS_RAY: set[str] = set()
+
+
 @pytest.fixture(scope="module")
 def local_ray():
     registry.EXPERIMENT_MODULES["toy"] = "tests.toy"  # trials get the registry from the driver
+    OTHERS_RAY.update(_ray_pids())
     start_ray(None, 2)
     yield
     import ray
@@ -37,7 +48,8 @@ def _sweep(tmp_path, name, seeds=(0, 1), **budget):
 
 def _ray_sockets():
     out = subprocess.run(["ss", "-tnlpH"], capture_output=True, text=True).stdout
-    return [line for line in out.splitlines() if any(p in line for p in ("raylet", "gcs_server", "ray::"))]
+    return [line for line in out.splitlines() if any(p in line for p in ("raylet", "gcs_server", "ray::"))
+            and not any(f"pid={pid}," in line for pid in OTHERS_RAY)]
 
 
 def _wait_for(path, timeout=120):
@@ -125,8 +137,8 @@ def test_no_ray_process_is_left_behind(local_ray):
     while _ray_sockets() and time.monotonic() < deadline:
         time.sleep(0.2)
     assert not _ray_sockets()
-    left = subprocess.run(["pgrep", "-f", "raylet|gcs_server"], capture_output=True, text=True).stdout
-    assert not left.strip(), left
+    left = _ray_pids() - OTHERS_RAY
+    assert not left, left
 
 
 # ------------------------------------------------------------------------- without Ray
