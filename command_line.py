@@ -96,6 +96,29 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
             p.add_argument("--episodes", type=EVAL_EPISODES, default=None, help="default 1; Minitaur 3")
             p.add_argument("--seed", type=NON_NEGATIVE, default=None,
                            help="episode i uses seed SEED+i (default: the first evaluation seed)")
+    export = sub.add_parser(
+        "export", help="the acting network as a TF SavedModel, a TFLite (LiteRT) file or an ONNX file, "
+                       "checked against the Keras model",
+        description="Export the acting network (Q-network, A2C actor, PPO's policy logits, SAC's mean "
+                    "action with its Standardize layer) and check it before reporting success: the file, "
+                    "loaded by its own runtime, against the Keras model on observations from the "
+                    "experiment's env on evaluation seeds. OUT gets the file and export.json; a failed "
+                    "check is one line, exit status 2, and OUT is left as it was. See docs/export.md.")
+    export.add_argument("experiment")
+    export.add_argument("algo")
+    export.add_argument("--format", required=True, choices=["savedmodel", "tflite", "onnx"])
+    export.add_argument("--model", default=None,
+                        help="model folder, a finished run's folder, or a run in progress (its last "
+                             "checkpoint) (default saved_networks/EXPERIMENT/ALGO)")
+    export.add_argument("--world", type=whole_number(WORLD), default=None,
+                        help="Mario: the shipped model of this world (default 1)")
+    export.add_argument("--stage", type=whole_number(STAGE), default=None,
+                        help="Mario: the shipped model of this stage (default 1)")
+    export.add_argument("--out", default=None, metavar="OUT",
+                        help="the export folder, new or an earlier export (default "
+                             "exports/EXPERIMENT_ALGO_FORMAT)")
+    export.add_argument("--observations", type=whole_number(Allowed(low=1, high=100_000)), default=256,
+                        help="observations the parity check feeds both networks (default 256)")
     sweep = sub.add_parser(
         "sweep", help="many runs (seeds x grid values) on Ray Tune, locally or on a cluster",
         description="One trial per combination of --seeds and --grid values; each trial is an ordinary "

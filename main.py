@@ -188,6 +188,23 @@ def cmd_render(args) -> int:
     return 0
 
 
+def cmd_export(args) -> int:
+    from rlcore.export import export_model, summary
+
+    name = f"{args.experiment}_{args.algo}"
+    if args.world or args.stage:
+        name += f"_{args.world or 1}-{args.stage or 1}"
+    out = Path(args.out) if args.out else Path("exports") / f"{name}_{args.format}"
+    with _model(args) as (model_dir, source):
+        record = export_model(model_dir, args.format, out, observations=args.observations, source=source,
+                              experiment=args.experiment, algo=args.algo)
+    print(f"export:  {out / record['file']} ({record['format']}, runs on {record['runtime']['name']} "
+          f"{record['runtime']['version']})")
+    print(f"parity:  {summary(record)} from seeds {record['parity']['seeds']}: passed")
+    print(f"record:  {out / 'export.json'}")
+    return 0
+
+
 def _run_folder(run_dir: Path) -> dict:
     """What the run in ``run_dir`` trained: its model's meta.json once finished (or a shipped model
     folder's own), else its checkpoint's state; a folder with none, or without metrics.csv, is a
@@ -231,8 +248,10 @@ def cmd_status(args) -> int:
 
 def cmd_sweep(args) -> int:
     from rlcore.experiment import get_experiment
+    from rlcore.extras import require
     from rlcore.sweep import Sweep, parse_grid, parse_seeds, run_sweep
 
+    require("ray.tune", "The sweep command")  # the sweep extra, or one line saying so
     exp = get_experiment(args.experiment)
     base = exp.preset(args.algo, args.preset)
     name = args.name or f"{args.experiment}__{args.algo}"
@@ -266,8 +285,10 @@ def cmd_sweep(args) -> int:
 
 
 def cmd_report(args) -> int:
+    from rlcore.extras import require
     from rlcore.report import keep, markdown, plot_curves, summarize
 
+    require("rliable.metrics", "The report command")  # the sweep extra, or one line saying so
     folders = [Path(d) for d in args.sweep_dirs]
     if args.keep:
         if len(folders) != 1:
@@ -286,14 +307,17 @@ def cmd_report(args) -> int:
 
 
 COMMANDS = {"list": cmd_list, "train": cmd_train, "evaluate": cmd_evaluate, "render": cmd_render,
-            "plot": cmd_plot, "status": cmd_status, "sweep": cmd_sweep, "report": cmd_report}
+            "plot": cmd_plot, "status": cmd_status, "sweep": cmd_sweep, "report": cmd_report,
+            "export": cmd_export}
 
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     try:
         args = build_parser(argv).parse_args(argv)
-        if args.command in ("train", "evaluate", "render"):
+        if args.command in ("train", "evaluate", "render", "export"):
+            from rlcore.extras import require_experiment
+            require_experiment(args.experiment)  # a missing extra (mario, minitaur): one line, no run folder
             from rlcore.quiet import load_tensorflow
             load_tensorflow()  # before any other module imports it: its start-up noise is dropped
         return COMMANDS[args.command](args)

@@ -34,7 +34,6 @@ TensorFlow-free: env-pool worker processes import this module.
 """
 from __future__ import annotations
 
-import cv2
 import gymnasium as gym
 import numpy as np
 
@@ -115,6 +114,8 @@ def gray_84(frame: np.ndarray) -> np.ndarray:
     cost 0.64 ms a frame here; reading the same bytes as contiguous BGRA takes 0.07 ms and gives
     the same gray image, bit for bit (the same weights on the same channels).
     """
+    import cv2  # the mario extra (imported here, so `main.py list` works without it)
+
     if frame.ndim == 3 and frame.strides[1:] == (4, -1):
         bgrx = np.lib.stride_tricks.as_strided(frame[:, :, ::-1], (*frame.shape[:2], 4),
                                                (frame.strides[0], 4, 1), writeable=False)
@@ -234,6 +235,10 @@ def make_env(render_mode: str | None = None, max_episode_steps: int | None = Non
     of that spacing, the point drawn by ``restart_weights``, each point's state kept by ``restart_keep``,
     the x stepped back by ``restart_back_step`` once ``restart_back_share`` of the restarts get past
     ``restart_goal_x`` (training only, :mod:`mario_ppo.restarts`)."""
+    from rlcore.extras import require
+
+    for module in ("cv2", "nes_py", "gym_super_mario_bros"):  # the mario extra, or one line
+        require(module, "Mario")
     import gym_super_mario_bros  # noqa: F401  registers the SuperMarioBros-* ids
     from nes_py.wrappers import JoypadSpace
 

@@ -15,6 +15,7 @@ from mario_ppo.episode_ends import StallLimit
 from mario_ppo.levels import STAGE, WORLD
 from mario_ppo.restarts import KEEPS, WEIGHTS
 from rlcore.allowed import OFF_OR_COUNT, Allowed, choices, require
+from rlcore import extras
 from rlcore.configs import PPOConfig
 from rlcore.experiment import AlgoSpec, Bar, Experiment
 
@@ -149,3 +150,5 @@ EXPERIMENT = Experiment(
     info_keys=("stalled", "start_x", "killed_by"), cause_key="killed_by", cause_name=cause_name,
     eval_episodes=10, ship_by=("world", "stage"), default_model="1-1", score_label="return (shaped, /10)",
 )
+
+extras.declare("mario_ppo", "Mario", "mario", ("cv2", "nes_py", "gym_super_mario_bros"))  # checked early

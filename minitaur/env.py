@@ -55,8 +55,10 @@ class MinitaurEnv(gym.Env):
         if render_mode not in (None, "rgb_array"):
             raise ValueError(f"render_mode {render_mode!r} is not supported; use 'rgb_array' or None")
         # pybullet prints its build time on import and "argv[0]=" on every connect
+        from rlcore.extras import require
+
         with filtered_stderr():
-            import pybullet
+            pybullet = require("pybullet", "Minitaur")  # the minitaur extra, or one line saying so
             import pybullet_data
             from pybullet_utils import bullet_client
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 import dataclasses
 
 from minitaur.env import make_env
+from rlcore import extras
 from rlcore.configs import SACConfig
 from rlcore.experiment import AlgoSpec, Bar, Experiment
 
@@ -36,3 +37,5 @@ EXPERIMENT = Experiment(
     bars={"sac": Bar("mean", 11.3, "the best published result on this task (RL Zoo's SB2 PPO2, 2M steps); "
                                    "article 004 peaked at 0.85", full_length_share=0.5)},  # the base's x position at the end: metres walked from the start
 )
+
+extras.declare("minitaur", "Minitaur", "minitaur", ("pybullet",))  # checked before a run folder exists

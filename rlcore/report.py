@@ -21,6 +21,7 @@ import numpy as np
 
 from rlcore.atomic import write_atomic
 from rlcore.errors import UserError
+from rlcore.extras import require
 
 AGGREGATES = ("mean", "median", "iqm")
 
@@ -32,7 +33,7 @@ def aggregates(scores: np.ndarray) -> np.ndarray:
     tasks: rliable's ``aggregate_median`` is the median over *tasks* of the per-task means, which
     for the single task of a sweep group is just the mean again.
     """
-    from rliable import metrics
+    metrics = require("rliable.metrics", "A sweep report")  # the sweep extra
 
     return np.array([metrics.aggregate_mean(scores), float(np.median(scores.mean(axis=1))),
                      metrics.aggregate_iqm(scores)])
@@ -61,7 +62,7 @@ def stratified_bootstrap_ci(statistic, *matrices: np.ndarray, reps: int = 5000, 
 
 def probability_of_improvement(x: np.ndarray, y: np.ndarray) -> float:
     """P(a run of X scores above a run of Y), ties counting half (rliable's definition)."""
-    from rliable import metrics
+    metrics = require("rliable.metrics", "A sweep report")  # the sweep extra
 
     return float(metrics.probability_of_improvement(x, y))
 
@@ -188,7 +189,7 @@ def plot_curves(result: dict, out: Path, reps: int = 1000) -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from rliable import metrics
+    metrics = require("rliable.metrics", "A sweep report")  # the sweep extra
 
     fig, ax = plt.subplots(figsize=(8, 4.5))
     for s in result["sweeps"]:

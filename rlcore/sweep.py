@@ -234,7 +234,9 @@ def start_ray(address: str | None, num_cpus: int | None) -> bool:
 def run_sweep(sweep: Sweep, address: str | None = None, num_cpus: int | None = None) -> list[dict]:
     """Run every unfinished trial of ``sweep`` on Ray Tune; return one result row per trial."""
     from rlcore import experiment as registry
+    from rlcore.extras import require
 
+    require("ray.tune", "A sweep")  # the sweep extra, or one line saying so (before any folder)
     check(sweep)
     folder = writable_folder(sweep.folder, "sweep folder")
     sweep.save()
