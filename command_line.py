@@ -185,6 +185,12 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
     status.add_argument("--rollout-block", type=COUNT, default=20,
                         help="PPO: rollouts per block in the lines that show update sizes, the "
                              "learning rate and the entropy weight (default 20)")
+
+    docs = sub.add_parser("docs", help="rewrite the README's and the docs' generated tables, the model cards "
+                                       "and the reference pages from meta.json, results/ and the registry",
+                          description="Rewrite every generated file and marked region (python -m rlcore.docgen).")
+    docs.add_argument("--check", action="store_true",
+                      help="write nothing; exit 1 listing every file that differs from what would be written")
     return parser
 
 

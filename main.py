@@ -306,8 +306,14 @@ def cmd_report(args) -> int:
     return 0
 
 
+def cmd_docs(args) -> int:
+    from rlcore.docgen import main as docgen_main
+
+    return docgen_main(["--check"] if args.check else [])
+
+
 COMMANDS = {"list": cmd_list, "train": cmd_train, "evaluate": cmd_evaluate, "render": cmd_render,
-            "plot": cmd_plot, "status": cmd_status, "sweep": cmd_sweep, "report": cmd_report,
+            "plot": cmd_plot, "status": cmd_status, "sweep": cmd_sweep, "report": cmd_report, "docs": cmd_docs,
             "export": cmd_export}
 
 

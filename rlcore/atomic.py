@@ -11,7 +11,7 @@ import tempfile
 from pathlib import Path
 from typing import Callable, Iterator
 
-from rlcore.errors import UserError
+from rlcore.errors import UserError, WriteFailed
 
 
 def writable_folder(folder: str | os.PathLike, what: str) -> Path:
@@ -33,17 +33,25 @@ def atomic_path(target: str | os.PathLike) -> Iterator[Path]:
 
     The temporary name keeps the target's suffix, so writers that pick a format from the
     extension (Keras ``.h5``, imageio ``.mp4``, numpy ``.npz``) still work.
+
+    A full disk or an unwritable folder is a :class:`WriteFailed` naming ``target``: the previous
+    file stays as it was and the temporary one is removed.
     """
     target = Path(target)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.stem}.", suffix=".tmp" + target.suffix,
-                               dir=target.parent)
+    try:
+        target.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{target.stem}.", suffix=".tmp" + target.suffix,
+                                   dir=target.parent)
+    except OSError as exc:
+        raise WriteFailed(target, exc) from None
     os.close(fd)
     tmp = Path(tmp)
     try:
         yield tmp
         os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the file normal permissions
         os.replace(tmp, target)
+    except OSError as exc:
+        raise WriteFailed(target, exc) from None
     finally:
         if tmp.exists():
             tmp.unlink()

@@ -6,6 +6,7 @@ offline otherwise. Never a prompt; with no network, ``online`` fails fast with o
 from __future__ import annotations
 
 import csv
+import io
 import math
 import netrc
 import os
@@ -76,7 +77,7 @@ class Tracker:
         self.on_row = on_row  # on_row(row, table): also hand every row to a caller (a Ray trial)
         self.run_dir.mkdir(parents=True, exist_ok=True)
         self.csv_path = self.run_dir / "metrics.csv"
-        self._tables: dict[str, tuple] = {}  # table name -> (file, csv.DictWriter)
+        self._tables: dict[str, tuple] = {}  # table name -> (binary file, its column names)
         self.wandb_run = None
         mode = resolve_wandb_mode(wandb_mode)
         if mode != "disabled":
@@ -137,23 +138,40 @@ class Tracker:
         return self.run_dir / f"{table}.csv"
 
     def log(self, row: dict, table: str = "metrics") -> None:
-        """Append ``row`` to ``<run_dir>/<table>.csv`` and send its numbers to wandb."""
-        if table not in self._tables:
-            path = self.table_path(table)
-            exists = path.exists() and path.stat().st_size > 0
-            fieldnames = _widen_header(path, list(row)) if exists else list(row)
-            handle = open(path, "a", newline="")
-            writer = csv.DictWriter(handle, fieldnames=fieldnames, extrasaction="ignore")
-            if not exists:
-                writer.writeheader()
-            self._tables[table] = (handle, writer)
-        handle, writer = self._tables[table]
-        writer.writerow(row)
-        handle.flush()
+        """Append ``row`` to ``<run_dir>/<table>.csv`` and send its numbers to wandb.
+
+        A row is written whole or not at all: on a full disk the table is cut back to its last
+        complete row and :class:`WriteFailed` names it.
+        """
+        path = self.table_path(table)
+        try:
+            if table not in self._tables:
+                exists = path.exists() and path.stat().st_size > 0
+                fieldnames = _widen_header(path, list(row)) if exists else list(row)
+                handle = open(path, "ab", buffering=0)  # unbuffered: a failed write leaves nothing pending
+                self._tables[table] = (handle, fieldnames)
+                if not exists:
+                    self._append(handle, dict(zip(fieldnames, fieldnames)), fieldnames)
+            handle, fieldnames = self._tables[table]
+            self._append(handle, row, fieldnames)
+        except OSError as exc:
+            raise WriteFailed(path, exc) from None
         if self.wandb_run is not None:
             self.wandb_run.log(wandb_row(row, table))
         if self.on_row is not None:
             self.on_row(row, table)
+
+    @staticmethod
+    def _append(handle, row: dict, fieldnames: list[str]) -> None:
+        text = io.StringIO()
+        csv.DictWriter(text, fieldnames=fieldnames, extrasaction="ignore").writerow(row)
+        data, end = text.getvalue().encode(), handle.seek(0, os.SEEK_END)
+        try:
+            while data:
+                data = data[handle.write(data):]
+        except OSError:
+            handle.truncate(end)  # no half-written row for a resume to trip on
+            raise
 
     def close(self) -> None:
         for handle, _ in self._tables.values():
