@@ -4,7 +4,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: venv demo test test-all benchmark save-long-runs clean
+.PHONY: venv demo test test-all benchmark save-long-runs clean docs docs-check
 
 # The venv is rebuilt when setup.cfg changes.
 $(STAMP): setup.cfg pyproject.toml
@@ -35,6 +35,17 @@ benchmark: $(STAMP)
 	$(PY) benchmarks/mario.py
 	$(PY) benchmarks/minitaur.py
 	$(PY) benchmarks/sweep.py
+
+# The docs: regenerate every generated page, card and README region from the artefacts, then build the
+# site into build/site/. docs-check changes nothing: it fails on drift or on a broken link (make test
+# runs the same checks in tests/test_docs.py).
+docs: $(STAMP)
+	$(PY) -m rlcore.docgen
+	$(VENV)/bin/mkdocs build --strict --quiet
+
+docs-check: $(STAMP)
+	$(PY) -m rlcore.docgen --check
+	$(VENV)/bin/mkdocs build --strict --quiet --site-dir build/site-check
 
 # Commit the checkpoints and CSV tables of the runs under long_runs/ (before every stop of a session).
 save-long-runs:
