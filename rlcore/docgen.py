@@ -92,9 +92,7 @@ class Model:
     @property
     def title(self) -> str:
         exp = get_experiment(self.experiment)
-        if exp.ship_by:
-            return f"{exp.algos[self.algo].description.split(',')[0]} on {self.env_id}"
-        return f"{exp.algos[self.algo].description} on {self.env_id}"
+        return f"{exp.algos[self.algo].description.split(',')[0]} on {self.env_id}"
 
 
 def read_json(path: Path) -> dict:
@@ -273,11 +271,10 @@ def region_results_table(page: str, arg: str) -> str:
         exp_page = f"docs/experiments/{EXPERIMENT_PAGES[m.experiment]}.md"
         article = article_of(m.experiment, m.algo)
         name = m.algo if m.name == m.algo else f"{m.algo} {m.name}"
-        rows.append([f"[{m.experiment}]({link(page, exp_page)})", f"[{name}]({link(page, card_path(m, page))})",
-                     article, m.env_id,
+        rows.append([f"[{m.env_id}]({link(page, exp_page)})", f"[{name}]({link(page, card_path(m, page))})", article,
                      f"**{score_text(m)}**", bar_text(m) + ("" if bar_met(m) == "met" else f" ({bar_met(m)})"),
                      iqm_text(m)])
-    return table(["experiment", "model (card)", "article", "env", "score on unseen seeds", "bar",
+    return table(["env (experiment page)", "model (card)", "article", "score on unseen seeds", "bar",
                   "5-seed IQM [95% CI]"], rows)
 
 
@@ -306,10 +303,11 @@ def region_shipped(page: str, experiment: str) -> str:
         meta, best = m.meta, m.meta.get("best_eval") or {}
         rows.append([f"[{m.name}]({link(page, card_path(m, page))})", f"`{meta.get('preset')}`",
                      f"{meta['env_steps']:,}", f"{meta['episodes']:,}", f"{meta['wall_seconds']:,.0f} s",
-                     num(best["mean"]) if "mean" in best else "–", f"**{score_text(m)}**",
-                     str(m.evaluation.get("episodes", "")), bar_text(m), bar_met(m)])
+                     num(best["mean"]) if "mean" in best else "–",
+                     f"**{score_text(m)}** ({m.evaluation.get('episodes', '?')} ep.)",
+                     f"{bar_text(m)}: {bar_met(m)}" if m.bar else "none set"])
     return table(["model", "preset", "env steps", "episodes", "wall", "best selection eval",
-                  "unseen seeds", "episodes", "bar", ""], rows, "llrrrrllll")
+                  "unseen seeds", "bar"], rows, "llrrrrll")
 
 
 def region_sweeps(page: str, experiment: str) -> str:

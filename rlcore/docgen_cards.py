@@ -52,7 +52,7 @@ def score_section(m: Model, page: str, docs: bool) -> str:
         if ev.get("causes"):
             rows += [["what ended the misses", ", ".join(f"{k} {v}" for k, v in ev["causes"].items())]]
     else:
-        rows += [["lowest episode", num(ev["min"])]]
+        rows += [["lowest episode", num(ev["min"], 1 if abs(ev["mean"]) >= 100 else 2)]]
         if "time_limit_share" in ev:
             rows += [["episodes that lasted to the time limit", f"{ev['time_limit_share']:.0%}"]]
         if "mean_x" in ev:
@@ -64,7 +64,7 @@ def score_section(m: Model, page: str, docs: bool) -> str:
     if "mean" in best:
         rows += [["best periodic evaluation during training (selection seeds, not unseen)",
                   f"{num(best['mean'])} at {best.get('env_steps', 0):,} env steps"]]
-    text = table(["", ""], rows) + "\n"
+    text = table(["evaluation", "result"], rows) + "\n"
     if m.sweep:
         agg = m.sweep.aggregates
         text += (f"\nThe same recipe over {len(m.sweep.seeds)} seeds ([report]({link(page, m.sweep.folder + '/report.md')}),"
@@ -145,7 +145,7 @@ def training_section(m: Model, page: str) -> str:
     rows.append(["versions", ", ".join(f"{k} {v}" for k, v in (meta.get("versions") or {}).items())])
     if meta.get("finished"):
         rows.append(["finished", meta["finished"][:10]])
-    text = table(["", ""], rows) + "\n\nThe commands of the run, in order (each resume keeps the settings of the " \
+    text = table(["training", ""], rows) + "\n\nThe commands of the run, in order (each resume keeps the settings of the " \
                                    "checkpoint, except those it gives again):\n\n" + commands_table(commands) + "\n"
     parent = meta.get("init_from")
     if isinstance(parent, dict):

@@ -82,18 +82,22 @@ def hyperparameters_page() -> str:
 
 
 def preset_differences(experiment: str, reference: str) -> str:
-    """Per algorithm of ``experiment``, the fields whose value differs between its presets."""
+    """Per algorithm of ``experiment``, the fields whose value differs between its presets (algorithms
+    whose differences are the same share one table)."""
     exp = get_experiment(experiment)
-    parts = []
+    groups: dict[tuple, list[str]] = {}
     for algo, spec in exp.algos.items():
         presets = spec.presets
         rows = []
         for f in dataclasses.fields(presets[spec.default_preset]):
             values = [_value(getattr(p, f.name)) if hasattr(p, f.name) else "–" for p in presets.values()]
             if len(set(values)) > 1:
-                rows.append([f"`--{f.name.replace('_', '-')}`", *values])
+                rows.append((f"`--{f.name.replace('_', '-')}`", *values))
         if rows:
-            parts += [f"**{algo}** ({spec.description})", "",
-                      table(["flag", *[f"`{p}`" for p in presets]], rows), ""]
+            groups.setdefault((tuple(presets), tuple(rows)), []).append(algo)
+    parts = []
+    for (names, rows), algos in groups.items():
+        parts += [", ".join(f"**{a}**" for a in algos), "",
+                  table(["flag", *[f"`{p}`" for p in names]], [list(r) for r in rows]), ""]
     parts.append(f"Every other field is the same in all presets: see [hyperparameters]({reference}#{experiment}).")
     return "\n".join(parts)
