@@ -290,7 +290,7 @@ def region_gif_strip(page: str, arg: str) -> str:
         return ("*No GIFs yet: `make gifs` writes them to `docs/assets/gifs/` from the shipped models, and "
                 "`python -m rlcore.docgen` then shows them here.*")
     images = [f"![{m.slug}]({link(page, m.gif)})" for m in shown]
-    captions = [f"{m.env_id} ({m.algo}): {score_text(m)}" for m in shown]
+    captions = [f"{m.env_id}, {m.algo}: {score_text(m)} ({m.evaluation.get('episodes')} unseen seeds)" for m in shown]
     return table(images, [captions], "c" * len(shown))
 
 
