@@ -44,7 +44,7 @@ ARTICLES = {
     "004": "SAC Minitaur (the TF-Agents colab, translated)",
 }
 #: the README's strip of GIFs: (experiment, model), shown when its GIF exists
-GIF_STRIP = (("mario_ppo", "1-1"), ("mario_ppo", "1-3"), ("lunar_lander", "dqn"), ("minitaur", "sac"),
+GIF_STRIP = (("mario_ppo", "1-1"), ("mario_ppo", "1-4"), ("lunar_lander", "dqn"), ("minitaur", "sac"),
              ("cartpole", "a2c"))
 
 
