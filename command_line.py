@@ -52,7 +52,7 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
     train.add_argument("--preset", default=None, help=PRESET_HELP)
     train.add_argument("--episodes", type=COUNT, default=None, help="episode budget (max_episodes)")
     train.add_argument("--steps", type=COUNT, default=None, help="env step budget (max_env_steps)")
-    train.add_argument("--seed", type=SEED, default=0,
+    train.add_argument("--seed", type=SEED, default=None,
                        help=f"0 to {MAX_RUN_SEED}: seeds numpy, TensorFlow and the envs (default 0); each run "
                             "seed owns its own training env seeds, all below the evaluation seeds")
     train.add_argument("--wandb", default="auto", choices=["auto", "online", "offline", "off"],

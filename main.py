@@ -41,9 +41,14 @@ def cmd_list(args) -> int:
     return 0
 
 
-def _budget_overrides(args) -> dict:
-    """``--episodes`` / ``--steps`` as the config fields they set."""
+def _budget_overrides(args, given: dict | None = None) -> dict:
+    """``--episodes`` / ``--steps`` as the config fields they set; ``given``: the hyperparameter flags
+    on the same line, where ``--max-episodes`` beside ``--episodes`` would be two answers to one question."""
     budget = {"max_episodes": args.episodes, "max_env_steps": args.steps}
+    for name, value in budget.items():
+        if value is not None and name in (given or {}):
+            short = "--episodes" if name == "max_episodes" else "--steps"
+            raise UserError(f"{short} and --{name.replace('_', '-')} set the same budget: give one")
     return {name: value for name, value in budget.items() if value is not None}
 
 
@@ -52,7 +57,8 @@ def _spec_from_args(args):
     from rlcore.run import build_spec
     from rlcore.trainers.spec import CHECKPOINT_FILE, latest_run_dir, new_run_dir
 
-    overrides = {**overrides_from_args(args), **_budget_overrides(args)}
+    given = overrides_from_args(args)
+    overrides = {**given, **_budget_overrides(args, given)}
     common = dict(preset=args.preset, seed=args.seed, overrides=overrides, wandb_mode=args.wandb,
                   progress=not args.no_progress)
     if args.resume is not None:
@@ -62,7 +68,7 @@ def _spec_from_args(args):
         state = read_checkpoint_state(run_dir / "checkpoint.npz")
         print(f"resuming {run_dir} at episode {len(state['returns'])}, env step {state['env_steps']}")
         return spec
-    run_dir = Path(args.run_dir) if args.run_dir else new_run_dir(args.experiment, args.algo, args.seed)
+    run_dir = Path(args.run_dir) if args.run_dir else new_run_dir(args.experiment, args.algo, args.seed or 0)
     held = [name for name in (CHECKPOINT_FILE, "metrics.csv") if (run_dir / name).is_file()]
     if held:  # a new run there would append to its tables and overwrite its checkpoint
         raise UserError(f"--run-dir {run_dir} already holds a run ({held[0]}); continue it with --resume "

@@ -83,6 +83,19 @@ class MarioPPOConfig(PPOConfig):
         require(not self.restart_back_step or self.restart_goal_x > self.restart_x > 0,
                 "--restart-back-step needs --restart-x and a --restart-goal-x past it")
 
+    def inert_fields(self) -> dict[str, str]:
+        inert = super().inert_fields()
+        if not (self.restart_x or self.restart_every):
+            inert.update(dict.fromkeys(("restart_share", "restart_keep", "restart_weights"),
+                                       "there is no restart point; add --restart-x or --restart-every"))
+        elif not self.restart_every:
+            inert["restart_weights"] = ("it weighs the points of --restart-every, and --restart-x gives a "
+                                        "single point")
+        if not self.restart_back_step:
+            inert.update(dict.fromkeys(("restart_goal_x", "restart_back_share"),
+                                       "it tunes --restart-back-step, which is off"))
+        return inert
+
 
 # Article 001: 8 envs x 512 steps, GAE gamma 0.99 lambda 0.97, clip 0.2, entropy 0.05, Adam 1e-4,
 # 10 epochs of minibatch 256, value loss added unweighted, TD(0) value target, its ratio and

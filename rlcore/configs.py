@@ -15,8 +15,10 @@ TAU = Allowed(low=0, high=1, low_open=True)
 VEC = choices("inline", "processes")
 
 
-def _h(default, text, allowed: Allowed | None = None):
-    return field(default=default, metadata={"help": text, "allowed": allowed})
+def _h(default, text, allowed: Allowed | None = None, defines_run: bool = False):
+    """A field with its help and allowed values; ``defines_run``: it shapes the env or the networks, so
+    a resume may not change it (:func:`rlcore.hparams.check_same_run`)."""
+    return field(default=default, metadata={"help": text, "allowed": allowed, "defines_run": defines_run})
 
 
 def _batch_fits_replay(cfg) -> None:
@@ -34,13 +36,18 @@ class RunBudget:
     max_env_steps: int = _h(0, "stop after this many env steps, all envs together (0 = no limit)",
                             OFF_OR_COUNT)
     max_episode_steps: int = _h(1000, "cap on steps per episode, longer ones are truncated "
-                                      "(0 = the env's registered limit)", OFF_OR_COUNT)
+                                      "(0 = the env's registered limit)", OFF_OR_COUNT, defines_run=True)
     stop_score: float = _h(200.0, "stop once the mean return of the last `window` episodes reaches this",
                            FINITE)
     window: int = _h(100, "episodes in the moving average", COUNT)
 
     def __post_init__(self):
         check_fields(self)
+
+    def inert_fields(self) -> dict[str, str]:
+        """Fields whose value does nothing with the other values -> why; a flag given for one of them
+        is refused (:func:`rlcore.hparams.check_no_inert`), not silently ignored."""
+        return {}
 
 
 @dataclass(frozen=True)
@@ -54,20 +61,27 @@ class EpisodeLoop(RunBudget):
     keep_best: bool = _h(False, "save the weights of the best periodic evaluation, not the last ones")
     stop_eval_score: float = _h(0.0, "stop once a periodic evaluation's mean reaches this (0 = off)", FINITE)
 
+    def inert_fields(self) -> dict[str, str]:
+        inert = super().inert_fields()
+        if not self.eval_every_steps:
+            inert.update(dict.fromkeys(("eval_episodes", "keep_best", "stop_eval_score"),
+                                       "periodic evaluations are off; add --eval-every-steps"))
+        return inert
+
 
 @dataclass(frozen=True)
 class DQNConfig(EpisodeLoop):
     """Q-learning with replay and a soft-updated target network (DQN, Double, Dueling)."""
-    hidden: tuple[int, ...] = _h((64, 64), "hidden layer sizes of the Q-network (comma separated)", COUNT)
-    dueling: bool = _h(False, "dueling head: Q = V(s) + A(s,a) - mean_a A(s,a)")
-    double: bool = _h(False, "double DQN target: the online net picks argmax, the target net values it")
+    hidden: tuple[int, ...] = _h((64, 64), "hidden layer sizes of the Q-network (comma separated)", COUNT, defines_run=True)
+    dueling: bool = _h(False, "dueling head: Q = V(s) + A(s,a) - mean_a A(s,a)", defines_run=True)
+    double: bool = _h(False, "double DQN target: the online net picks argmax, the target net values it", defines_run=True)
     lr: float = _h(1e-3, "learning rate", POSITIVE)
-    optimizer: str = _h("adam", "adamw uses amsgrad, as the PyTorch tutorial", choices("adam", "adamw"))
+    optimizer: str = _h("adam", "adamw uses amsgrad, as the PyTorch tutorial", choices("adam", "adamw"), defines_run=True)
     loss: str = _h("mse", "loss on the TD error", choices("mse", "huber"))
     grad_clip_value: float = _h(0.0, "clip each gradient element to +-this value (0 = off)",
                                 NON_NEGATIVE)
     gamma: float = _h(0.995, "discount factor", UNIT)
-    buffer_size: int = _h(100_000, "replay memory capacity (transitions)", COUNT)
+    buffer_size: int = _h(100_000, "replay memory capacity (transitions)", COUNT, defines_run=True)
     batch_size: int = _h(64, "minibatch size", COUNT)
     learn_every: int = _h(4, "one gradient step every this many env steps", COUNT)
     learning_starts: int = _h(64, "env steps collected before the first gradient step", NON_NEGATIVE)
@@ -86,6 +100,14 @@ class DQNConfig(EpisodeLoop):
         super().__post_init__()
         _batch_fits_replay(self)
 
+    def inert_fields(self) -> dict[str, str]:
+        inert = super().inert_fields()
+        if self.eps_schedule == "episode":
+            inert["eps_decay_steps"] = "it is the time constant of --eps-schedule steps, and the schedule is episode"
+        else:
+            inert["eps_decay"] = "it is the factor of --eps-schedule episode, and the schedule is steps"
+        return inert
+
 
 @dataclass(frozen=True)
 class A2CConfig(EpisodeLoop):
@@ -94,12 +116,12 @@ class A2CConfig(EpisodeLoop):
     ``gae_lambda = 0`` is the article's one-step TD target r + gamma V(s'); ``gae_lambda = 1``
     is the n-step return bootstrapped from the end of the rollout.
     """
-    actor_hidden: tuple[int, ...] = _h((256, 256), "actor hidden layer sizes", COUNT)
-    critic_hidden: tuple[int, ...] = _h((256, 256), "critic hidden layer sizes", COUNT)
+    actor_hidden: tuple[int, ...] = _h((256, 256), "actor hidden layer sizes", COUNT, defines_run=True)
+    critic_hidden: tuple[int, ...] = _h((256, 256), "critic hidden layer sizes", COUNT, defines_run=True)
     actor_lr: float = _h(3e-4, "actor learning rate", POSITIVE)
     critic_lr: float = _h(5e-4, "critic learning rate", POSITIVE)
     gamma: float = _h(0.995, "discount factor", UNIT)
-    num_envs: int = _h(1, "environments stepped together", COUNT)
+    num_envs: int = _h(1, "environments stepped together", COUNT, defines_run=True)
     vec: str = _h("inline", "inline: one process, fastest for cheap envs; processes: one per env, over Pipes",
                   VEC)
     n_steps: int = _h(4, "env steps per env between updates", COUNT)
@@ -118,7 +140,7 @@ class PPOConfig(RunBudget):
     shuffled minibatches. ``article_quirks`` restores the article's loss: ratio p / (p_old + 1e-3)
     instead of exp(log p - log p_old), and log p(a) of the taken action in place of the entropy.
     """
-    num_envs: int = _h(8, "environments stepped together", COUNT)
+    num_envs: int = _h(8, "environments stepped together", COUNT, defines_run=True)
     vec: str = _h("processes", "processes: one per env, over Pipes; inline: one process", VEC)
     n_steps: int = _h(512, "env steps per env in one rollout", COUNT)
     epochs: int = _h(10, "passes over each rollout", COUNT)
@@ -167,9 +189,9 @@ class PPOConfig(RunBudget):
 @dataclass(frozen=True)
 class SACConfig(EpisodeLoop):
     """Soft actor-critic with a tanh-squashed Gaussian actor, twin critics and a learned temperature."""
-    actor_hidden: tuple[int, ...] = _h((256, 256), "actor hidden layer sizes", COUNT)
+    actor_hidden: tuple[int, ...] = _h((256, 256), "actor hidden layer sizes", COUNT, defines_run=True)
     critic_hidden: tuple[int, ...] = _h((256, 256), "hidden layer sizes of each critic (on state and action)",
-                                        COUNT)
+                                        COUNT, defines_run=True)
     actor_lr: float = _h(3e-4, "actor learning rate", POSITIVE)
     critic_lr: float = _h(3e-4, "critic learning rate (one Adam over both critics)", POSITIVE)
     alpha_lr: float = _h(3e-4, "temperature learning rate", POSITIVE)
@@ -178,7 +200,7 @@ class SACConfig(EpisodeLoop):
     gamma: float = _h(0.99, "discount factor", UNIT)
     tau: float = _h(0.005, "soft target update rate, every gradient step", TAU)
     batch_size: int = _h(256, "minibatch size", COUNT)
-    buffer_size: int = _h(1_000_000, "replay memory capacity (transitions)", COUNT)
+    buffer_size: int = _h(1_000_000, "replay memory capacity (transitions)", COUNT, defines_run=True)
     learning_starts: int = _h(10_000, "initial env steps with uniform random actions, before any update",
                               NON_NEGATIVE)
     updates_per_call: int = _h(1, "gradient steps batched into one compiled call, taken every this many "
@@ -186,7 +208,7 @@ class SACConfig(EpisodeLoop):
     log_std_min: float = _h(-20.0, "lower clip of the actor's log standard deviation", FINITE)
     log_std_max: float = _h(2.0, "upper clip of the actor's log standard deviation", FINITE)
     obs_norm: bool = _h(False, "standardize observations with the running mean and std of every "
-                               "observation so far (clipped to +-10), kept inside the saved networks")
+                               "observation so far (clipped to +-10), kept inside the saved networks", defines_run=True)
 
     def __post_init__(self):
         super().__post_init__()

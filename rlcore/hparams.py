@@ -86,3 +86,32 @@ def from_dict(cls, data: dict):
             value = data[f.name]
             kwargs[f.name] = tuple(value) if typing.get_origin(hints[f.name]) is tuple else value
     return cls(**kwargs)
+
+
+def defining_fields(cfg, env_fields: tuple[str, ...] = ()) -> list[str]:
+    """The fields that say what a run is: its env (``env_fields``, the time limit) and its networks
+    (fields declared with ``defines_run``)."""
+    return [f.name for f in dataclasses.fields(cfg) if f.metadata.get("defines_run") or f.name in env_fields]
+
+
+def check_same_run(recorded, overrides: dict, env_fields: tuple[str, ...], run_dir) -> None:
+    """A resume may change budgets, rates, coefficients and logging, not what the run is: an override
+    of a defining field with another value than the recorded one is a :class:`UserError`."""
+    for name in defining_fields(recorded, env_fields):
+        if name in overrides and overrides[name] != getattr(recorded, name):
+            flag = "--" + name.replace("_", "-")
+            raise UserError(f"{flag} cannot change on --resume: the run in {run_dir} was recorded with "
+                            f"{name} = {_shown(getattr(recorded, name))}, and it defines the env or the "
+                            f"networks; start a new run to change it")
+
+
+def check_no_inert(cfg, given) -> None:
+    """A flag given on the command line that does nothing with the others is a :class:`UserError`
+    (the config's ``inert_fields()``: field -> why it does nothing)."""
+    inert = getattr(cfg, "inert_fields", lambda: {})()
+    for name in sorted(set(given) & set(inert)):
+        raise UserError(f"--{name.replace('_', '-')} does nothing here: {inert[name]}")
+
+
+def _shown(value) -> str:
+    return ",".join(map(str, value)) if isinstance(value, tuple) else str(value)

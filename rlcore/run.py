@@ -15,14 +15,16 @@ from pathlib import Path
 from typing import Callable
 
 from rlcore.experiment import get_experiment
-from rlcore.hparams import apply_overrides, from_dict
+from rlcore.errors import UserError
+from rlcore.hparams import apply_overrides, check_no_inert, check_same_run, from_dict
 from rlcore.trainers.spec import RunSpec, check_resumable
 
 
-def build_spec(experiment: str, algo: str, *, preset: str | None = None, seed: int = 0,
+def build_spec(experiment: str, algo: str, *, preset: str | None = None, seed: int | None = None,
                overrides: dict | None = None, run_dir: Path, resume: bool = False,
                wandb_mode: str = "auto", progress: bool = True, command: str | None = None) -> RunSpec:
-    """The :class:`RunSpec` of a new run (``resume=False``) or of the run in ``run_dir``."""
+    """The :class:`RunSpec` of a new run (``resume=False``; ``seed`` None = 0) or of the run in
+    ``run_dir``, whose seed, preset and defining fields a resume may not change."""
     exp = get_experiment(experiment)
     overrides = dict(overrides or {})
     extra = {} if command is None else {"command": command}
@@ -31,11 +33,23 @@ def build_spec(experiment: str, algo: str, *, preset: str | None = None, seed: i
                        progress=progress, **extra)
         state = check_resumable(spec)
         config_class = type(exp.preset(algo, None))
-        # the checkpoint's own hyperparameters; budgets (or any field) may be given again
-        spec.config = apply_overrides(from_dict(config_class, state["config"]), overrides)
+        # the checkpoint's own hyperparameters; budgets, rates and coefficients may be given again,
+        # what defines the env or the networks may not
+        recorded = from_dict(config_class, state["config"])
+        check_same_run(recorded, overrides, exp.env_fields, run_dir)
+        spec.config = apply_overrides(recorded, overrides)
+        check_no_inert(spec.config, overrides)
+        if preset is not None and preset != state["preset"]:
+            raise UserError(f"--preset {preset} cannot change on --resume: the run in {run_dir} was started "
+                            f"from the {state['preset']} preset")
+        if seed is not None and seed != state["seed"]:
+            raise UserError(f"--seed {seed} cannot change on --resume: the run in {run_dir} has seed "
+                            f"{state['seed']}")
         spec.preset, spec.seed = state["preset"], state["seed"]
         return spec
     config = apply_overrides(exp.preset(algo, preset), overrides)
+    check_no_inert(config, overrides)
+    seed = 0 if seed is None else seed
     return RunSpec(exp, algo, preset or exp.algo(algo).default_preset, config, seed, wandb_mode,
                    Path(run_dir), progress=progress, **extra)
 

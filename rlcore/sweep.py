@@ -125,13 +125,13 @@ def parse_grid(items: list[str], config) -> dict[str, list]:
 def check(sweep: Sweep) -> None:
     """Build every trial's config once, so a bad value stops the sweep before Ray starts."""
     from rlcore.experiment import get_experiment
-    from rlcore.hparams import apply_overrides
+    from rlcore.hparams import apply_overrides, check_no_inert
 
     exp = get_experiment(sweep.experiment)
     base = exp.preset(sweep.algo, sweep.preset)
     for trial in sweep.trials():
         values = {k: v for k, v in trial.items() if k != "seed"}
-        apply_overrides(base, {**sweep.overrides, **values})
+        check_no_inert(apply_overrides(base, {**sweep.overrides, **values}), values)
 
 
 # ------------------------------------------------------------------------------------- the trial

@@ -1,0 +1,114 @@
+"""A resume cannot change what a run is (its env, its networks, its seed or preset), and no flag is
+accepted and then ignored: each is one line and exit status 2, before anything is written."""
+import json
+
+import numpy as np
+import pytest
+
+import main
+from rlcore.experiment import get_experiment
+from rlcore.hparams import defining_fields, to_dict
+
+
+def run(capsys, *argv):
+    try:
+        code = main.main(list(argv))
+    except SystemExit as exc:  # argparse
+        code = exc.code
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def fake_run(folder, experiment: str, algo: str, preset: str = "default", seed: int = 0, **changes):
+    """A run folder whose checkpoint records ``experiment algo`` (the state only: enough to be refused)."""
+    import dataclasses
+
+    config = dataclasses.replace(get_experiment(experiment).preset(algo, preset), **changes)
+    state = {"experiment": experiment, "algo": algo, "preset": preset, "seed": seed,
+             "config": to_dict(config), "returns": [], "env_steps": 0}
+    folder.mkdir(parents=True)
+    payload = np.frombuffer(json.dumps(state).encode(), np.uint8)
+    np.savez(folder / "checkpoint.npz", state_json=payload)
+    return folder
+
+
+@pytest.mark.parametrize("experiment, algo, flag, value", [
+    ("mario_ppo", "ppo", "--stage", "2"),
+    ("mario_ppo", "ppo", "--frames", "history"),
+    ("mario_ppo", "ppo", "--actions", "complex"),
+    ("mario_ppo", "ppo", "--num-envs", "4"),
+    ("lunar_lander", "dqn", "--hidden", "32,32"),
+    ("lunar_lander", "dueling_ddqn", "--dueling", "false"),
+    ("minitaur", "sac", "--obs-norm", "false"),
+    ("cartpole", "a2c", "--max-episode-steps", "100"),
+])
+def test_resume_refuses_a_change_of_what_the_run_is(capsys, tmp_path, experiment, algo, flag, value):
+    folder = fake_run(tmp_path / "run", experiment, algo)
+    field = flag[2:].replace("-", "_")
+    recorded = getattr(get_experiment(experiment).preset(algo, None), field)
+    recorded = ",".join(map(str, recorded)) if isinstance(recorded, tuple) else str(recorded)
+    assert recorded != value.replace("false", "False")
+    before = sorted(p.name for p in folder.iterdir())
+    code, out, err = run(capsys, "train", experiment, algo, "--resume", str(folder), flag, value)
+    assert code == 2
+    line = err.strip()
+    assert "\n" not in line and flag in line and f"{field} = {recorded}" in line, line
+    assert sorted(p.name for p in folder.iterdir()) == before  # nothing written there
+
+
+def test_every_env_field_and_network_size_is_a_defining_field():
+    mario = get_experiment("mario_ppo")
+    fields = defining_fields(mario.preset("ppo", None), mario.env_fields)
+    for name in ("world", "stage", "actions", "frames", "num_envs", "max_episode_steps"):
+        assert name in fields
+    for name in ("lr", "entropy_coef", "max_env_steps", "checkpoint_rollouts", "precision", "restart_x"):
+        assert name not in fields  # budgets, rates, coefficients, logging and curricula may change
+    sac = get_experiment("minitaur").preset("sac", None)
+    assert {"actor_hidden", "critic_hidden", "obs_norm"} <= set(defining_fields(sac))
+
+
+def test_resume_may_change_budgets_rates_and_coefficients(tmp_path):
+    """Given again with a new value, or a defining field with its recorded one: accepted."""
+    folder = fake_run(tmp_path / "run", "lunar_lander", "dqn")
+    from rlcore.run import build_spec
+
+    spec = build_spec("lunar_lander", "dqn", run_dir=folder, resume=True,
+                      overrides={"lr": 1e-4, "max_episodes": 50, "tau": 0.01, "hidden": get_experiment("lunar_lander").preset("dqn", None).hidden})
+    assert (spec.config.lr, spec.config.max_episodes, spec.config.tau) == (1e-4, 50, 0.01)
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["--seed", "3"], "--seed 3 cannot change on --resume"),
+    (["--preset", "article"], "--preset article cannot change on --resume"),
+])
+def test_resume_refuses_another_seed_or_preset(capsys, tmp_path, argv, words):
+    folder = fake_run(tmp_path / "run", "lunar_lander", "dqn")
+    code, _, err = run(capsys, "train", "lunar_lander", "dqn", "--resume", str(folder), *argv)
+    assert code == 2 and words in err, err
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["mario_ppo", "ppo", "--restart-share", "0.3"], "--restart-share does nothing here"),
+    (["mario_ppo", "ppo", "--restart-keep", "furthest"], "--restart-keep does nothing here"),
+    (["mario_ppo", "ppo", "--restart-x", "500", "--restart-weights", "deaths"], "--restart-weights does nothing"),
+    (["mario_ppo", "ppo", "--restart-goal-x", "900"], "--restart-goal-x does nothing here"),
+    (["mario_ppo", "ppo", "--restart-x", "500", "--restart-back-share", "0.4"], "--restart-back-share does nothing"),
+    (["lunar_lander", "dqn", "--episodes", "5", "--max-episodes", "9"], "--episodes and --max-episodes"),
+    (["lunar_lander", "dqn", "--steps", "5", "--max-env-steps", "9"], "--steps and --max-env-steps"),
+    (["lunar_lander", "dqn", "--eps-decay-steps", "500"], "--eps-decay-steps does nothing here"),
+    (["cartpole", "dqn", "--eps-decay", "0.9"], "--eps-decay does nothing here"),
+    (["minitaur", "sac", "--eval-every-steps", "0", "--keep-best", "true"], "--keep-best does nothing here"),
+])
+def test_a_flag_that_would_do_nothing_is_refused(capsys, tmp_path, argv, words):
+    code, _, err = run(capsys, "train", *argv, "--run-dir", str(tmp_path / "run"))
+    assert code == 2 and words in err and "\n" not in err.strip(), err
+    assert not (tmp_path / "run").exists()
+
+
+def test_the_same_flags_with_what_they_need_are_accepted():
+    from rlcore.hparams import apply_overrides, check_no_inert
+
+    mario = get_experiment("mario_ppo").preset("ppo", None)
+    for given in ({"restart_x": 500, "restart_share": 0.3}, {"restart_every": 400, "restart_weights": "deaths"},
+                  {"restart_x": 500, "restart_back_step": 50, "restart_goal_x": 900, "restart_back_share": 0.4}):
+        check_no_inert(apply_overrides(mario, given), given)
