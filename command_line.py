@@ -90,7 +90,8 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
                            help="write the result into the model folder's meta.json as its evaluation")
         else:
             p.add_argument("--out", default=None,
-                           help="MP4 path, or a folder for it (default videos/EXPERIMENT_ALGO.mp4)")
+                           help="an .mp4 or a .gif path (a GIF: ~320 px wide, every few frames, looping), "
+                                "or a folder for an MP4 (default videos/EXPERIMENT_ALGO.mp4)")
             p.add_argument("--fps", type=whole_number(Allowed(low=1, high=240)), default=None,
                            help="frames per second (default: experiment's)")
             p.add_argument("--episodes", type=EVAL_EPISODES, default=None, help="default 1; Minitaur 3")

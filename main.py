@@ -172,8 +172,12 @@ def _render(model_dir: Path, out: Path, fps: int | None, episodes: int | None, s
     act = policy.sample if exp.success_key else None  # Mario plays as it was evaluated
     result = record_video(exp, policy, out, fps or exp.video_fps, episodes, seed,
                           make_env=policy.make_env, act=act)
-    print(f"video:   {out} ({result['frames']} frames at {result['fps']} fps; "
-          f"episode returns {', '.join(f'{r:.1f}' for r in result['returns'])})")
+    shown = (f"{result['frames']} frames at {result['fps']} fps" if "every" not in result else
+             f"{result['frames']} frames from {result['frames_played']} at {result['fps']} fps: 1 in "
+             f"{result['every']} kept, repeats merged; {result['bytes'] / 1e6:.2f} MB")
+    reached = f"; reached the goal: {result['success']}" if "success" in result else ""
+    print(f"video:   {out} ({shown}; "
+          f"episode returns {', '.join(f'{r:.1f}' for r in result['returns'])}{reached})")
 
 
 def cmd_render(args) -> int:
@@ -185,8 +189,8 @@ def cmd_render(args) -> int:
     out = Path(args.out) if args.out else Path("videos") / f"{name}.mp4"
     if out.is_dir():
         out = out / f"{name}.mp4"
-    if out.suffix.lower() != ".mp4":
-        raise UserError(f"--out {out}: give a file name ending in .mp4, or a folder")
+    from rlcore.video import check_video_path
+    out = check_video_path(out)  # .mp4 or .gif (by the suffix), else one line
     with _model(args) as (model_dir, _):
         load_policy(model_dir, args.experiment, args.algo)  # checks before any file is written
         writable_folder(out.parent, "--out")

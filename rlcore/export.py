@@ -54,8 +54,8 @@ def export_model(model_dir: str | os.PathLike, fmt: str, out_dir: str | os.PathL
     if fmt not in FORMATS:
         raise UserError(f"unknown export format {fmt!r}; choose one of {', '.join(FORMATS)}")
     out_dir = Path(out_dir)
-    _check_out(out_dir)
     runtime = runtime_of(fmt)  # the runtime's packages, before any work (a missing one: one line)
+    _check_out(out_dir)
     exp, meta, policy = load_policy(model_dir, experiment, algo)
     kind = exp.algo(meta["algo"]).kind
     acting, as_trained = acting_network(policy.model, kind)
