@@ -4,7 +4,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: venv demo test test-all benchmark save-long-runs clean docs docs-check
+.PHONY: venv demo test benchmark save-long-runs clean docs docs-check
 
 # The venv is rebuilt when setup.cfg changes.
 $(STAMP): setup.cfg pyproject.toml
@@ -23,10 +23,6 @@ demo: $(STAMP)
 
 test: $(STAMP)
 	$(PY) -m pytest -q
-
-# Also the slow learning runs marked `expensive`.
-test-all: $(STAMP)
-	$(PY) -m pytest -q -m ""
 
 # Speed measurements, one JSON line each (several minutes: they train to solved).
 benchmark: $(STAMP)

@@ -50,8 +50,14 @@ class TrainingSession:
         self.book.solved_episode = state.get("solved_episode")
         self.env_steps = int(state.get("env_steps", 0))
         self._wall_before, self._started = float(state.get("wall_seconds", 0.0)), time.perf_counter()
-        # the command that started the run, then one per resume
-        self.commands = list(state.get("commands", [])) + [spec.command]
+        # the command that started the run, then one per resume; beside each, where it took effect
+        # (None for the commands of checkpoints written before 2026-11-27, which did not record it)
+        earlier = list(state.get("commands", []))
+        starts = list(state.get("command_starts") or [])
+        self.commands = earlier + [spec.command]
+        self.command_starts = ([None] * (len(earlier) - len(starts)) + starts
+                               + [{"env_steps": self.env_steps, "episodes": self.book.episodes,
+                                   **({"rollouts": int(state["rollouts"])} if "rollouts" in state else {})}])
         self.evaluation = PeriodicEvaluation(cfg, state)
         self.evaluation.restore_best_arrays(resumed_arrays or {})
         self.stop = StopRequest(spec.stop_file)
@@ -130,7 +136,8 @@ class TrainingSession:
                                     if len(self.book.counted_returns) != self.book.episodes else None),
                 "solved_episode": self.book.solved_episode, "env_steps": self.env_steps,
                 "wall_seconds": self.elapsed(), "wandb_id": self.tracker.wandb_id,
-                **self.evaluation.state(), "commands": self.commands, **extra}
+                **self.evaluation.state(), "commands": self.commands, "command_starts": self.command_starts,
+                **extra}
 
     def best_arrays(self) -> dict:
         return self.evaluation.best_arrays()
@@ -156,7 +163,8 @@ class TrainingSession:
             load_weights(self.evaluation.best_weights)
         book = self.book
         return write_model_folder(self.run_dir, self.spec.experiment, self.spec.describe(), save_models, {
-            "commands": self.commands, "env_steps": self.env_steps, "episodes": book.episodes,
+            "commands": self.commands, "command_starts": self.command_starts,
+            "env_steps": self.env_steps, "episodes": book.episodes,
             "wall_seconds": round(self.elapsed(), 1), "solved_episode": book.solved_episode,
             "final_average": round(book.average, 2), "stopped_by": self.stop_reason,
             "weights": "best periodic evaluation" if kept_best else "last",
