@@ -113,9 +113,9 @@ def test_an_unwritable_output_place_is_one_line_exit_2(capsys, tmp_path, argv, w
     assert len(err.strip().splitlines()) == 1 and block.read_text() == "a file, not a folder"
 
 
-def test_render_wants_an_mp4_name_or_a_folder(capsys, tmp_path):
-    code, _, err = run(capsys, "render", "lunar_lander", "dqn", "--out", str(tmp_path / "demo.gif"))
-    assert code == 2 and "give a file name ending in .mp4, or a folder" in err
+def test_render_wants_an_mp4_or_gif_name_or_a_folder(capsys, tmp_path):
+    code, _, err = run(capsys, "render", "lunar_lander", "dqn", "--out", str(tmp_path / "demo.avi"))
+    assert code == 2 and "give a file name ending in .mp4 or .gif, or a folder" in err
     assert list(tmp_path.iterdir()) == []
 
 
