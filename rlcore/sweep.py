@@ -2,6 +2,7 @@
 
     sweeps/<name>/sweep.json            what the sweep is (experiment, algo, preset, seeds, grid, budgets)
     sweeps/<name>/<trial>/              metrics.csv, checkpoint.npz, model/ (meta.json) ...: a run folder
+    sweeps/<name>/trials.log            a line per start and end of each trial's attempt
     sweeps/<name>/_tune/                Ray Tune's own records
 
 A trial calls :func:`rlcore.run.run_training`, the function ``main.py train`` calls, and reports
@@ -9,7 +10,8 @@ every logged row to Tune as it comes. Fault tolerance lives in the run folder, n
 that starts where a checkpoint exists resumes it (so a trial whose worker was killed and that Tune
 restarts continues its counters; one killed before its first checkpoint starts over, its tables
 cleared), and a trial whose ``model/meta.json`` exists is finished and is
-not run again (``--resume``). Ctrl-C or SIGTERM writes ``sweeps/<name>/STOP``: every running trial
+not run again (``--resume``). A trial that fails with a user error (a bad value, a diverged loss, a
+run folder another process writes) is reported once, not retried: a retry would fail the same way. Ctrl-C or SIGTERM writes ``sweeps/<name>/STOP``: every running trial
 stops at its next safe point with a checkpoint, and the sweep ends (then Ray is shut down; a driver
 killed outright would leave Ray's workers running).
 
@@ -34,6 +36,7 @@ from rlcore.trainers.stopping import STOP_SIGNALS
 
 SWEEP_FILE = "sweep.json"
 STOP_FILE = "STOP"
+TRIALS_LOG = "trials.log"
 
 
 @dataclass
@@ -150,9 +153,25 @@ def run_trial(trial: dict, sweep: dict, modules: dict, report) -> dict:
         return final_metrics(json.loads(meta_path.read_text()), skipped=True)
     from rlcore.run_lock import hold_run_folder
 
-    with hold_run_folder(run_dir):  # one writer: a trial restarted while its old worker lives is refused
-        (run_dir / "worker.pid").write_text(f"{os.getpid()}\n")
-        return _train_trial(trial, sweep, run_dir, report)
+    log_trial(sweep, trial, "started")
+    try:
+        with hold_run_folder(run_dir):  # one writer: a trial restarted while its old worker lives is refused
+            (run_dir / "worker.pid").write_text(f"{os.getpid()}\n")
+            return _train_trial(trial, sweep, run_dir, report)
+    except UserError as exc:  # a bad value, a diverged loss, a busy folder: a retry would fail the same way
+        log_trial(sweep, trial, f"failed: {exc}")
+        return {"error": str(exc), "failed": 1}
+    except BaseException as exc:  # the worker's own end (Ray restarts it from the checkpoint)
+        log_trial(sweep, trial, f"stopped: {type(exc).__name__}")
+        raise
+
+
+def log_trial(sweep: Sweep, trial: dict, event: str) -> None:
+    """One line in the sweep's trials.log per start and per end of a trial's attempt (with the worker's
+    pid), so restarts and failures can be counted afterwards."""
+    line = f"{time.strftime('%Y-%m-%dT%H:%M:%S')} {trial_name(trial)} pid {os.getpid()} {event}\n"
+    with open(Path(sweep.folder) / TRIALS_LOG, "a") as log:
+        log.write(line)
 
 
 def _train_trial(trial: dict, sweep: Sweep, run_dir: Path, report) -> dict:
@@ -274,6 +293,6 @@ def run_sweep(sweep: Sweep, address: str | None = None, num_cpus: int | None = N
     rows = []
     for result in grid:
         metrics = result.metrics or {}
-        rows.append({"trial": trial_name({k: v for k, v in result.config.items()}),
-                     "error": str(result.error).splitlines()[0] if result.error else None, **metrics})
+        error = str(result.error).splitlines()[0] if result.error else metrics.get("error")
+        rows.append({"trial": trial_name({k: v for k, v in result.config.items()}), **metrics, "error": error})
     return rows

@@ -130,6 +130,19 @@ def test_ctrl_c_stops_at_a_checkpoint_and_resume_skips_finished_trials(local_ray
     assert (trial / "model" / "meta.json").stat().st_mtime == finished_mtime
 
 
+def test_a_trial_that_fails_with_a_user_error_is_reported_once_not_retried(local_ray, tmp_path):
+    """Its run folder is written by another process (this one): the trial is refused, and a retry
+    would be refused the same way, so there is none."""
+    from rlcore.run_lock import hold_run_folder
+
+    sweep = _sweep(tmp_path, "busy", seeds=(0,))
+    with hold_run_folder(tmp_path / "busy" / "seed=0"):
+        rows = run_sweep(sweep)
+    assert "is being written by process" in rows[0]["error"], rows
+    log = (tmp_path / "busy" / "trials.log").read_text().splitlines()
+    assert [line.split()[-1] if "started" in line else line.split()[4] for line in log] == ["started", "failed:"]
+
+
 def test_no_ray_process_is_left_behind(local_ray):
     import ray
     ray.shutdown()
