@@ -21,6 +21,7 @@ Local Ray is started here with a fixed CPU count, no dashboard and every service
 from __future__ import annotations
 
 import argparse
+import contextlib
 import itertools
 import json
 import os
@@ -244,10 +245,23 @@ def start_ray(address: str | None, num_cpus: int | None) -> bool:
         ray.init(address=address, runtime_env=runtime_env, log_to_driver=False)
         return True
     from rlcore.quiet import filtered_stderr
-    with filtered_stderr():
+    with filtered_stderr(), ignoring_stop_signals():
         ray.init(num_cpus=num_cpus or os.cpu_count(), include_dashboard=False, _node_ip_address="127.0.0.1",
                  runtime_env=runtime_env, log_to_driver=False, configure_logging=False)
     return True
+
+
+@contextlib.contextmanager
+def ignoring_stop_signals():
+    """SIGINT and SIGTERM blocked while local Ray starts its services, which inherit the mask: a
+    signal to the whole process group (Ctrl-C, timeout, a scheduler) then reaches only the driver,
+    which stops every trial at a checkpoint and shuts Ray down, instead of killing Ray's services under
+    the trials. (Ray blocks SIGINT in its services itself; SIGTERM ended them at once.)"""
+    blocked = signal.pthread_sigmask(signal.SIG_BLOCK, set(STOP_SIGNALS))
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
 
 
 def run_sweep(sweep: Sweep, address: str | None = None, num_cpus: int | None = None) -> list[dict]:

@@ -5,8 +5,10 @@ import json
 import os
 import signal
 import subprocess
+import sys
 import threading
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -17,6 +19,7 @@ from rlcore.report import aggregates, load_runs, probability_of_improvement, str
 from rlcore.sweep import STOP_FILE, Sweep, parse_grid, parse_seeds, run_sweep, start_ray
 from tests.test_cli import run
 
+ROOT = Path(__file__).resolve().parents[1]
 BUDGET = {"max_episodes": 40, "stop_score": 99.0, "checkpoint_every": 10}
 
 
@@ -283,3 +286,23 @@ def test_a_trial_killed_before_its_first_checkpoint_starts_over_without_its_old_
     episodes = [int(line.split(",")[0]) for line in rows]
     assert episodes == list(range(1, len(episodes) + 1)) and len(episodes) >= 2
     assert not any("-12345" in line for line in rows)
+
+
+def test_sigterm_to_the_sweeps_process_group_stops_its_trials_at_a_checkpoint(tmp_path):
+    """As `timeout` or a scheduler sends it: to the driver and every process it started. Ray's services
+    must not die under the trials (they started with the signal blocked); the driver stops the trials."""
+    from tests.test_stop_signals import group_is_gone
+
+    folder = tmp_path / "group"
+    proc = subprocess.Popen([sys.executable, "main.py", "sweep", "cartpole", "dqn", "--seeds", "0",
+                             "--episodes", "5000", "--dir", str(tmp_path), "--name", "group", "--num-cpus", "1"],
+                            cwd=ROOT, start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True)
+    _wait_for(folder / "seed=0" / "checkpoint.npz", timeout=240)
+    os.killpg(proc.pid, signal.SIGTERM)
+    out, err = proc.communicate(timeout=180)
+    assert proc.returncode == 130, err[-2000:]
+    assert "seed=0: stopped at a checkpoint" in out, out
+    assert group_is_gone(proc.pid, timeout=30)
+    log = (folder / "trials.log").read_text()
+    assert log.count("started") == 1 and "failed" not in log
