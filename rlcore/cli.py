@@ -7,7 +7,8 @@
   python main.py render lunar_lander dqn [--out lander.mp4]
 
 TensorFlow is imported only inside the commands that need it, so `list` and `--help` are quick.
-The command line itself (every flag and the values it allows) is `command_line.py`.
+The command line itself (every flag and the values it allows) is :mod:`rlcore.command_line`; the
+installed ``deeprl`` script and a checkout's ``main.py`` both call :func:`main`.
 """
 from __future__ import annotations
 
@@ -20,7 +21,7 @@ from pathlib import Path
 
 os.environ.setdefault("TF_CPP_MIN_LOG_LEVEL", "2")
 
-from command_line import build_parser  # noqa: E402  (TF-free, as the rest here)
+from rlcore.command_line import build_parser  # noqa: E402  (TF-free, as the rest here)
 from rlcore import shipping  # noqa: E402
 from rlcore.errors import UserError  # noqa: E402
 from rlcore.atomic import writable_folder  # noqa: E402

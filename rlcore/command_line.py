@@ -1,4 +1,4 @@
-"""The command line of main.py: one subcommand per mode, and for `train` one flag per hyperparameter
+"""The command line (``deeprl``, or ``python main.py`` in a checkout): one subcommand per mode, and for `train` one flag per hyperparameter
 of the chosen experiment's preset. Every value is checked here, before any run folder exists; a bad
 command line is one line and exit status 2.
 
@@ -28,7 +28,7 @@ def folder_name(text: str) -> str:
     return text
 
 
-PRESET_HELP = ("a named set of hyperparameters: article, default, or another that `main.py list` shows "
+PRESET_HELP = ("a named set of hyperparameters: article, default, or another that `list` shows "
                "(default: default)")
 COUNT, NON_NEGATIVE = whole_number(allowed.COUNT), whole_number(allowed.NON_NEGATIVE)
 SEED = whole_number(Allowed(low=0, high=MAX_RUN_SEED))
@@ -36,19 +36,57 @@ EVAL_EPISODES = whole_number(Allowed(low=1, high=MAX_EVAL_EPISODES))  # one unse
 FINAL_EVAL_EPISODES = whole_number(Allowed(low=0, high=MAX_EVAL_EPISODES))
 
 
-def build_parser(argv: list[str]) -> argparse.ArgumentParser:
+EXAMPLES = """examples:
+  {prog} list                                    experiments, algorithms, presets, shipped models
+  {prog} render mario_ppo ppo --world 1 --stage 1 --out mario.gif
+  {prog} evaluate lunar_lander dqn --episodes 20  a shipped model on unseen seeds
+  {prog} train lunar_lander dqn --seed 1 --lr 5e-4
+  {prog} train lunar_lander dqn --resume          continue the latest run from its checkpoint
+  {prog} export minitaur sac --format onnx --out exports/minitaur
+the docs: docs/ in the repository (`make docs` builds the site)"""
+
+
+def program_name(argv0: str | None = None) -> str:
+    """``deeprl`` when run as the installed script, else ``main.py`` (a checkout, the tests, the docs)."""
+    import os
+    import sys
+
+    name = os.path.basename(sys.argv[0] if argv0 is None else argv0)
+    return "deeprl" if name.startswith("deeprl") else "main.py"
+
+
+def package_version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("deeprl-tf2")
+    except PackageNotFoundError:  # a checkout that was never installed
+        return "unknown (not installed: pip install -e .)"
+
+
+def _algorithms_by_experiment() -> str:
+    from rlcore.experiment import experiment_names, get_experiment
+
+    return "; ".join(f"{name}: {', '.join(get_experiment(name).algos)}" for name in experiment_names())
+
+
+def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentParser:
+    from rlcore.experiment import experiment_names
+
+    prog = prog or program_name()
     parser = _Parser(
-        prog="main.py", description="TensorFlow 2 / Keras deep RL: train, evaluate and render agents.",
-        epilog="`main.py list` shows experiments, algorithms, presets and shipped models.")
+        prog=prog, description="TensorFlow 2 / Keras deep RL: train, evaluate, render and export agents.",
+        epilog=EXAMPLES.format(prog=prog), formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--version", action="version", version=f"%(prog)s {package_version()}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND", parser_class=_Parser)
 
     sub.add_parser("list", help="experiments, algorithms, presets and shipped models with their scores")
 
     train = sub.add_parser("train", help="train an agent (Ctrl-C or SIGTERM saves a checkpoint; --resume continues)",
                            description="Train an agent. Every hyperparameter of the chosen preset can be "
-                                       "overridden; `main.py train EXPERIMENT ALGO --help` lists them.")
-    train.add_argument("experiment", help="e.g. lunar_lander")
-    train.add_argument("algo", help="e.g. dqn, ddqn, dueling_dqn, dueling_ddqn, a2c")
+                                       f"overridden; `{prog} train EXPERIMENT ALGO --help` lists them.")
+    train.add_argument("experiment", help=f"one of {', '.join(experiment_names())}")
+    train.add_argument("algo", help=f"an algorithm of the experiment ({_algorithms_by_experiment()})")
     train.add_argument("--preset", default=None, help=PRESET_HELP)
     train.add_argument("--episodes", type=COUNT, default=None, help="episode budget (max_episodes)")
     train.add_argument("--steps", type=COUNT, default=None, help="env step budget (max_env_steps)")
@@ -71,10 +109,10 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
 
     for name, text in (("evaluate", "greedy mean +- std of a saved model on unseen seeds "
                                     "(Mario: share of episodes reaching the flag, x position)"),
-                       ("render", "MP4 of a saved model playing (greedily; Mario samples from pi)")):
+                       ("render", "an MP4 or GIF of a saved model playing (greedily; Mario samples from pi)")):
         p = sub.add_parser(name, help=text, description=text)
-        p.add_argument("experiment")
-        p.add_argument("algo")
+        p.add_argument("experiment", help=f"one of {', '.join(experiment_names())}")
+        p.add_argument("algo", help="an algorithm of the experiment (`list` shows them)")
         p.add_argument("--model", default=None,
                        help="model folder, a finished run's folder, or a run in progress (its last "
                             "checkpoint) (default saved_networks/EXPERIMENT/ALGO)")
@@ -126,8 +164,8 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
                     "run folder under DIR/NAME/ (evaluate, render and plot work on it). A trial "
                     "restarted after a crash resumes from its checkpoint; Ctrl-C or SIGTERM stops every trial "
                     "at a checkpoint; --resume continues and skips finished trials.")
-    sweep.add_argument("experiment")
-    sweep.add_argument("algo")
+    sweep.add_argument("experiment", help=f"one of {', '.join(experiment_names())}")
+    sweep.add_argument("algo", help="an algorithm of the experiment (`list` shows them)")
     sweep.add_argument("--seeds", default="0-4", help="a range or a list: 0-4, 0,3,7 (default 0-4)")
     sweep.add_argument("--grid", action="append", default=[], metavar="NAME=V1,V2",
                        help="a hyperparameter and its values (repeatable), e.g. --grid lr=1e-4,3e-4")

@@ -168,9 +168,8 @@ class PPOConfig(RunBudget):
     normalize_advantage: bool = _h(False, "standardize advantages within each minibatch")
     article_quirks: bool = _h(False, "the article's ratio p/(p_old+1e-3) and log p(a) as entropy")
     precision: str = _h("float32", "bfloat16: the CNN's feature layers compute in bfloat16 (weights, heads "
-                                   "and losses stay float32); a PPO update took 7.8 s instead of 14.0 on a "
-                                   "CPU with AMX, 6.5 instead of 11.7 on one with avx512_bf16; "
-                                   "benchmarks/mario.py measures both on yours",
+                                   "and losses stay float32); faster only on CPUs with AMX or avx512_bf16 "
+                                   "(the docs' speed page; benchmarks/mario.py measures both on yours)",
                         choices("float32", "bfloat16"))
     checkpoint_rollouts: int = _h(10, "rollouts between checkpoints", COUNT)
     stop_success_share: float = _h(0.0, "stop once this share of the last `window` episodes "

@@ -28,7 +28,7 @@ def _subcommands(parser: argparse.ArgumentParser) -> dict[str, argparse.Argument
 
 
 def cli_page() -> str:
-    from command_line import build_parser
+    from rlcore.command_line import build_parser
 
     parser = build_parser(["list"])
     parts = [GENERATED_NOTE, "", "# Command line", "",

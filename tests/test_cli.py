@@ -269,3 +269,17 @@ def test_evaluate_and_render_a_run_in_progress_and_a_finished_run_folder(capsys,
     dqn_trainer.train(spec)  # finishes: model/ appears
     code, out, err = run(capsys, "evaluate", "toy", "dqn", "--model", str(spec.run_dir), "--episodes", "3")
     assert code == 0 and f"({spec.run_dir / 'model'}): " in out, err
+
+
+def test_the_installed_script_is_deeprl_and_says_its_version():
+    """`pip install` puts the `deeprl` script and the packages in site-packages, no top-level `main`."""
+    from importlib.metadata import distribution
+
+    dist = distribution("deeprl-tf2")
+    scripts = {e.name: e.value for e in dist.entry_points if e.group == "console_scripts"}
+    assert scripts == {"deeprl": "rlcore.cli:main"}
+    script = Path(sys.executable).parent / "deeprl"
+    done = subprocess.run([str(script), "--version"], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0 and done.stdout.strip() == f"deeprl {dist.version}"
+    helped = subprocess.run([str(script), "train", "--help"], capture_output=True, text=True, timeout=60)
+    assert helped.stdout.startswith("usage: deeprl train") and "mario_ppo: ppo" in helped.stdout

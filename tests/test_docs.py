@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from command_line import build_parser
+from rlcore.command_line import build_parser
 
 REPO = Path(__file__).resolve().parents[1]
 DOC_FILES = [REPO / "README.md"] + sorted((REPO / "docs").rglob("*.md"))
