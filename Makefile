@@ -2,30 +2,54 @@
 PYTHON ?= python3.13
 VENV   := .venv
 PY     := $(VENV)/bin/python
-STAMP  := $(VENV)/.installed
+# Installs are locked: constraints.txt pins every package to the version the tests and the shipped
+# models last ran with. `make lock` refreshes it from a fresh install (a deliberate step: run the
+# tests after it, commit it with what it changed).
+LOCK   := constraints.txt
+CORE   := $(VENV)/.installed-core
+ALL    := $(VENV)/.installed-all
 
-.PHONY: venv demo test benchmark save-long-runs clean docs docs-check
+.PHONY: venv demo test lock benchmark save-long-runs clean docs docs-check
 
-# The venv is rebuilt when setup.cfg changes.
-$(STAMP): setup.cfg pyproject.toml
+$(PY):
 	@command -v $(PYTHON) >/dev/null 2>&1 || { echo "error: $(PYTHON) not found; install Python 3.13 (pyenv install 3.13) or run make PYTHON=/path/to/python3.13"; exit 1; }
-	test -x $(PY) || $(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e '.[all]'
-	touch $(STAMP)
+	$(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet -c $(LOCK) --upgrade pip
 
-venv: $(STAMP)
+# What `make demo` needs: the core (LunarLander, CartPole, any Gymnasium env). Redone when setup.cfg or
+# the lock changes.
+$(CORE): setup.cfg pyproject.toml $(LOCK) | $(PY)
+	$(PY) -m pip install --quiet -c $(LOCK) -e .
+	touch $@
+
+# What `make test` needs: every extra (mario, minitaur, sweep, docs, export, test).
+$(ALL): setup.cfg pyproject.toml $(LOCK) | $(PY)
+	$(PY) -m pip install --quiet -c $(LOCK) -e '.[all]'
+	touch $@ $(CORE)
+
+# Install only (every extra), no training and no tests.
+venv: $(ALL)
 
 # Train the default experiment (LunarLander DQN, default preset) until solved, evaluate it,
 # then write its plot and an MP4 of the trained agent. wandb: online if logged in, else offline.
-demo: $(STAMP)
+demo: $(CORE)
 	$(PY) main.py train lunar_lander dqn --video
 
-test: $(STAMP)
+test: $(ALL)
 	$(PY) -m pytest -q
 
+# Refresh the lock: every package at the newest version setup.cfg allows, installed into a fresh venv,
+# frozen into constraints.txt. Then `make test`, and commit the lock with what it changed.
+lock:
+	rm -rf .venv-lock
+	$(PYTHON) -m venv .venv-lock
+	.venv-lock/bin/python -m pip install --quiet --upgrade pip
+	.venv-lock/bin/python -m pip install --quiet -e '.[all]'
+	.venv-lock/bin/python -m pip freeze --all --exclude-editable > $(LOCK)
+	rm -rf .venv-lock
+
 # Speed measurements, one JSON line each (several minutes: they train to solved).
-benchmark: $(STAMP)
+benchmark: $(ALL)
 	$(PY) benchmarks/lunar_lander.py dqn
 	$(PY) benchmarks/cartpole.py --train a2c
 	$(PY) benchmarks/mario.py
@@ -35,11 +59,11 @@ benchmark: $(STAMP)
 # The docs: regenerate every generated page, card and README region from the artefacts, then build the
 # site into build/site/. docs-check changes nothing: it fails on drift or on a broken link (make test
 # runs the same checks in tests/test_docs.py).
-docs: $(STAMP)
+docs: $(ALL)
 	$(PY) -m rlcore.docgen
 	$(VENV)/bin/mkdocs build --strict --quiet
 
-docs-check: $(STAMP)
+docs-check: $(ALL)
 	$(PY) -m rlcore.docgen --check
 	$(VENV)/bin/mkdocs build --strict --quiet --site-dir build/site-check
 
@@ -49,7 +73,7 @@ docs-check: $(STAMP)
 # 1-1 on 1000000, 1-4 on 1000001 (it fell short on 1000000). `render` prints whether it did again.
 GIF_DIR := docs/assets/gifs
 .PHONY: gifs
-gifs: $(STAMP)
+gifs: $(ALL)
 	$(PY) main.py render mario_ppo ppo --world 1 --stage 1 --seed 1000000 --out $(GIF_DIR)/mario_ppo_1-1.gif
 	$(PY) main.py render mario_ppo ppo --world 1 --stage 4 --seed 1000001 --out $(GIF_DIR)/mario_ppo_1-4.gif
 	$(PY) main.py render lunar_lander dqn --seed 1000000 --out $(GIF_DIR)/lunar_lander_dqn.gif
