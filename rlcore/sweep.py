@@ -69,7 +69,9 @@ class Sweep:
         path = Path(folder) / SWEEP_FILE
         if not path.is_file():
             raise UserError(f"no sweep to resume in {folder} (no {SWEEP_FILE}); start it without --resume")
-        return cls(**json.loads(path.read_text()))
+        data = json.loads(path.read_text())
+        data["folder"] = str(Path(folder).resolve())  # where it is now (a clone elsewhere), not where it began
+        return cls(**data)
 
 
 def trial_name(trial: dict) -> str:

@@ -176,6 +176,15 @@ def test_bootstrap_ci_on_known_answers():
     assert probability_of_improvement(scores, scores) == pytest.approx(0.5)
 
 
+def test_a_sweep_moved_to_another_folder_resumes_where_it_now_is(tmp_path):
+    """A sweep kept in git (long_runs/sweeps/) resumes from a clone in another place."""
+    first = _sweep(tmp_path, "here")
+    Path(first.folder).mkdir()
+    first.save()
+    (tmp_path / "here").rename(tmp_path / "there")
+    assert Sweep.load(tmp_path / "there").folder == str((tmp_path / "there").resolve())
+
+
 def test_seeds_and_grid_parsing():
     from rlcore.configs import DQNConfig
 
