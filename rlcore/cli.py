@@ -43,25 +43,21 @@ def cmd_list(args) -> int:
 
 
 def _budget_overrides(args, given: dict | None = None) -> dict:
-    """``--episodes`` / ``--steps`` as the config fields they set; ``given``: the hyperparameter flags
-    on the same line, where ``--max-episodes`` beside ``--episodes`` would be two answers to one question."""
-    budget = {"max_episodes": args.episodes, "max_env_steps": args.steps}
-    for name, value in budget.items():
-        if value is not None and name in (given or {}):
-            short = "--episodes" if name == "max_episodes" else "--steps"
-            raise UserError(f"{short} and --{name.replace('_', '-')} set the same budget: give one")
-    return {name: value for name, value in budget.items() if value is not None}
+    """``--episodes`` / ``--steps`` as the config fields they set (:func:`rlcore.run.budget_overrides`)."""
+    from rlcore.run import budget_overrides
+
+    return budget_overrides(args.episodes, args.steps, given)
 
 
 def _spec_from_args(args):
     from rlcore.hparams import overrides_from_args
-    from rlcore.run import build_spec
-    from rlcore.trainers.spec import CHECKPOINT_FILE, latest_run_dir, new_run_dir
+    from rlcore.run import build_spec, check_new_run_dir
+    from rlcore.trainers.spec import latest_run_dir, new_run_dir
 
     given = overrides_from_args(args)
     overrides = {**given, **_budget_overrides(args, given)}
     common = dict(preset=args.preset, seed=args.seed, overrides=overrides, wandb_mode=args.wandb,
-                  progress=not args.no_progress)
+                  progress=not args.no_progress, command=getattr(args, "command_line", None))
     if args.resume is not None:
         run_dir = latest_run_dir(args.experiment, args.algo) if args.resume == "latest" else Path(args.resume)
         spec = build_spec(args.experiment, args.algo, run_dir=run_dir, resume=True, **common)
@@ -70,31 +66,23 @@ def _spec_from_args(args):
         print(f"resuming {run_dir} at episode {len(state['returns'])}, env step {state['env_steps']}")
         return spec
     run_dir = Path(args.run_dir) if args.run_dir else new_run_dir(args.experiment, args.algo, args.seed or 0)
-    held = [name for name in (CHECKPOINT_FILE, "metrics.csv") if (run_dir / name).is_file()]
-    if held:  # a new run there would append to its tables and overwrite its checkpoint
-        raise UserError(f"--run-dir {run_dir} already holds a run ({held[0]}); continue it with --resume "
-                        f"{run_dir}, or give another --run-dir")
+    check_new_run_dir(run_dir)
     return build_spec(args.experiment, args.algo, run_dir=run_dir, **common)
 
 
 def cmd_train(args) -> int:
-    from rlcore.run import run_training
+    from rlcore.run import train_and_evaluate
+    from rlcore.trainers.spec import folder_safe
 
     spec = _spec_from_args(args)
     print(f"training {spec.experiment.name} {spec.algo} ({spec.preset} preset, seed {spec.seed}) "
           f"-> {spec.run_dir}")
-    model_dir = run_training(spec)
-    meta = json.loads((model_dir / "meta.json").read_text())
-    print(f"trained: {meta['episodes']} episodes, {meta['env_steps']} env steps, "
-          f"{meta['wall_seconds']:.0f} s; last-100 average {meta['final_average']:.1f}")
-    episodes = shipping.eval_episodes(spec.experiment, args.final_eval_episodes)
-    if episodes > 0:
-        meta = shipping.evaluate_into_meta(model_dir, episodes)
+    model_dir, meta = train_and_evaluate(spec, args.final_eval_episodes)
     print(f"model:   {model_dir}/")
     print(f"plot:    {model_dir / meta['plot']}")
     print(f"metrics: {model_dir / 'metrics.csv'}")
     if args.video:
-        _render(model_dir, model_dir / f"{spec.experiment.name}_{spec.algo}.mp4", None, None, None)
+        _render(model_dir, model_dir / f"{folder_safe(spec.experiment.name)}_{spec.algo}.mp4", None, None, None)
     if args.publish:
         target = shipping.shipped_dir(spec.experiment.name, spec.algo, spec.config)
         shipping.publish(model_dir, target)
@@ -165,14 +153,9 @@ def cmd_evaluate(args) -> int:
 
 
 def _render(model_dir: Path, out: Path, fps: int | None, episodes: int | None, seed: int | None) -> None:
-    from rlcore.policies import load_policy
-    from rlcore.video import record_video
+    from rlcore.api import load, render_policy
 
-    exp, meta, policy = load_policy(model_dir)
-    episodes = exp.episodes_per_video if episodes is None else episodes
-    act = policy.sample if exp.success_key else None  # Mario plays as it was evaluated
-    result = record_video(exp, policy, out, fps or exp.video_fps, episodes, seed,
-                          make_env=policy.make_env, act=act)
+    result = render_policy(load(model_dir), out, fps, episodes, seed)
     shown = (f"{result['frames']} frames at {result['fps']} fps" if "every" not in result else
              f"{result['frames']} frames from {result['frames_played']} at {result['fps']} fps: 1 in "
              f"{result['every']} kept, repeats merged; {result['bytes'] / 1e6:.2f} MB")
@@ -184,7 +167,9 @@ def _render(model_dir: Path, out: Path, fps: int | None, episodes: int | None, s
 def cmd_render(args) -> int:
     from rlcore.policies import load_policy
 
-    name = f"{args.experiment}_{args.algo}"
+    from rlcore.trainers.spec import folder_safe
+
+    name = f"{folder_safe(args.experiment)}_{args.algo}"
     if args.world or args.stage:
         name += f"_{args.world or 1}-{args.stage or 1}"
     out = Path(args.out) if args.out else Path("videos") / f"{name}.mp4"
@@ -202,7 +187,9 @@ def cmd_render(args) -> int:
 def cmd_export(args) -> int:
     from rlcore.export import export_model, summary
 
-    name = f"{args.experiment}_{args.algo}"
+    from rlcore.trainers.spec import folder_safe
+
+    name = f"{folder_safe(args.experiment)}_{args.algo}"
     if args.world or args.stage:
         name += f"_{args.world or 1}-{args.stage or 1}"
     out = Path(args.out) if args.out else Path("exports") / f"{name}_{args.format}"
@@ -323,6 +310,20 @@ def cmd_docs(args) -> int:
     return docgen_main(["--check"] if args.check else [])
 
 
+def _register_recorded_env(model: str | None) -> None:
+    """A model of a user's Gymnasium env, named by its id alone: register the env again from the
+    model's meta.json (its entry point), as the process that trained it had."""
+    if not model:
+        return
+    from rlcore.gym_experiment import register_from_record
+
+    for meta_path in (Path(model) / "meta.json", Path(model) / "model" / "meta.json"):
+        if meta_path.is_file():
+            with contextlib.suppress(ValueError, OSError):
+                register_from_record(json.loads(meta_path.read_text()).get("env") or {})
+            return
+
+
 COMMANDS = {"list": cmd_list, "train": cmd_train, "evaluate": cmd_evaluate, "render": cmd_render,
             "plot": cmd_plot, "status": cmd_status, "sweep": cmd_sweep, "report": cmd_report, "docs": cmd_docs,
             "export": cmd_export}
@@ -332,8 +333,12 @@ def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     try:
         args = build_parser(argv).parse_args(argv)
+        if argv != sys.argv[1:]:  # called with its own arguments (a test, a script): record those, not
+            import shlex          # the arguments of the process that called it
+            args.command_line = shlex.join(["python", "main.py", *argv])
         if args.command in ("train", "evaluate", "render", "export"):
             from rlcore.extras import require_experiment
+            _register_recorded_env(getattr(args, "model", None))
             require_experiment(args.experiment)  # a missing extra (mario, minitaur): one line, no run folder
             from rlcore.quiet import load_tensorflow
             load_tensorflow()  # before any other module imports it: its start-up noise is dropped

@@ -41,6 +41,7 @@ EXAMPLES = """examples:
   {prog} render mario_ppo ppo --world 1 --stage 1 --out mario.gif
   {prog} evaluate lunar_lander dqn --episodes 20  a shipped model on unseen seeds
   {prog} train lunar_lander dqn --seed 1 --lr 5e-4
+  {prog} train Acrobot-v1 ppo --steps 200000      any Gymnasium id whose spaces fit the algorithm
   {prog} train lunar_lander dqn --resume          continue the latest run from its checkpoint
   {prog} export minitaur sac --format onnx --out exports/minitaur
 the docs: docs/ in the repository (`make docs` builds the site)"""
@@ -85,8 +86,12 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
     train = sub.add_parser("train", help="train an agent (Ctrl-C or SIGTERM saves a checkpoint; --resume continues)",
                            description="Train an agent. Every hyperparameter of the chosen preset can be "
                                        f"overridden; `{prog} train EXPERIMENT ALGO --help` lists them.")
-    train.add_argument("experiment", help=f"one of {', '.join(experiment_names())}")
-    train.add_argument("algo", help=f"an algorithm of the experiment ({_algorithms_by_experiment()})")
+    train.add_argument("experiment", help=f"one of {', '.join(experiment_names())}, or any registered Gymnasium "
+                                          "id whose spaces fit ALGO (Acrobot-v1; MODULE:ID imports the module "
+                                          "that registers your own env first)")
+    train.add_argument("algo", help=f"an algorithm of the experiment ({_algorithms_by_experiment()}); for a "
+                                    "Gymnasium id: dqn, ddqn, dueling_dqn, dueling_ddqn, a2c, ppo (discrete "
+                                    "actions) or sac (continuous actions)")
     train.add_argument("--preset", default=None, help=PRESET_HELP)
     train.add_argument("--episodes", type=COUNT, default=None, help="episode budget (max_episodes)")
     train.add_argument("--steps", type=COUNT, default=None, help="env step budget (max_env_steps)")
@@ -111,7 +116,8 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
                                     "(Mario: share of episodes reaching the flag, x position)"),
                        ("render", "an MP4 or GIF of a saved model playing (greedily; Mario samples from pi)")):
         p = sub.add_parser(name, help=text, description=text)
-        p.add_argument("experiment", help=f"one of {', '.join(experiment_names())}")
+        p.add_argument("experiment", help=f"one of {', '.join(experiment_names())}, or the Gymnasium id a "
+                                          "--model was trained on")
         p.add_argument("algo", help="an algorithm of the experiment (`list` shows them)")
         p.add_argument("--model", default=None,
                        help="model folder, a finished run's folder, or a run in progress (its last "

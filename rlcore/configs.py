@@ -134,7 +134,8 @@ class A2CConfig(EpisodeLoop):
 
 @dataclass(frozen=True)
 class PPOConfig(RunBudget):
-    """PPO with clipped surrogate, GAE and a shared CNN feature (article 001).
+    """PPO with clipped surrogate, GAE and a shared CNN feature (article 001); on vector observations
+    two tanh MLPs (policy, value) instead of the CNN.
 
     One update = ``epochs`` passes over a rollout of ``n_steps`` x ``num_envs`` transitions in
     shuffled minibatches. ``article_quirks`` restores the article's loss: ratio p / (p_old + 1e-3)
@@ -142,6 +143,9 @@ class PPOConfig(RunBudget):
     """
     num_envs: int = _h(8, "environments stepped together", COUNT, defines_run=True)
     vec: str = _h("processes", "processes: one per env, over Pipes; inline: one process", VEC)
+    hidden: tuple[int, ...] = _h((64, 64), "hidden layer sizes of the policy MLP and of the value MLP, for "
+                                           "vector observations (image observations go through the CNN)",
+                                 COUNT, defines_run=True)
     n_steps: int = _h(512, "env steps per env in one rollout", COUNT)
     epochs: int = _h(10, "passes over each rollout", COUNT)
     minibatch: int = _h(256, "transitions per gradient step", COUNT)

@@ -4,7 +4,7 @@ from __future__ import annotations
 from collections import Counter
 
 import numpy as np
-from tqdm import tqdm
+from tqdm.auto import tqdm  # a widget in a notebook, text in a terminal
 
 from rlcore.vector import final_info
 

@@ -1,4 +1,5 @@
-"""The registry: experiment name -> env factory, algorithms, presets, solved threshold.
+"""The registry: experiment name -> env factory, algorithms, presets, solved threshold; any other
+name that is a Gymnasium id becomes an experiment of its own (:mod:`rlcore.gym_experiment`).
 
 TensorFlow-free, so ``main.py list`` and env-pool workers import it cheaply. Experiment packages
 are imported lazily by module path.
@@ -115,6 +116,12 @@ class Experiment:
     # the bar each shipped model must clear, by model folder name (the algorithm, or Mario's level):
     # the one place it is written; tests, cards and the README read it here
     bars: dict[str, Bar] = field(default_factory=dict)
+    # algorithms that cannot train on this env -> why, in one clause (a Gymnasium id's spaces:
+    # ``sac`` on discrete actions); asking for one is that one line, not "unknown algorithm"
+    unfit: dict[str, str] = field(default_factory=dict)
+    # what meta.json records of the env beyond the experiment's name, so a model folder rebuilds it in
+    # a fresh process (a Gymnasium id: its entry point, kwargs, limits; rlcore.gym_experiment)
+    env_record: dict = field(default_factory=dict)
 
     def training_env_factory(self, config) -> Callable:
         """:meth:`env_factory` plus the training-only fields (``train_env_fields``)."""
@@ -138,6 +145,10 @@ class Experiment:
         return self.bars.get(model)
 
     def algo(self, name: str) -> AlgoSpec:
+        if name in self.unfit:
+            fitting = (f"; algorithms that fit it: {', '.join(self.algos)}" if self.algos
+                       else "; no algorithm of this package fits it")
+            raise UserError(f"{name} does not fit {self.name}: {self.unfit[name]}{fitting}")
         if name not in self.algos:
             raise UserError(f"unknown algorithm {name!r} for {self.name}; choose one of "
                             f"{', '.join(self.algos)}")
@@ -156,7 +167,18 @@ def experiment_names() -> list[str]:
     return list(EXPERIMENT_MODULES)
 
 
-def get_experiment(name: str) -> Experiment:
-    if name not in EXPERIMENT_MODULES:
-        raise UserError(f"unknown experiment {name!r}; choose one of {', '.join(EXPERIMENT_MODULES)}")
-    return importlib.import_module(EXPERIMENT_MODULES[name]).EXPERIMENT
+def get_experiment(name: str, env_record: dict | None = None) -> Experiment:
+    """The experiment ``name``: a package's (``lunar_lander`` ...), else a registered Gymnasium id
+    (``Acrobot-v1``, or ``my_envs:Maze-v0`` to import ``my_envs`` first; :mod:`rlcore.gym_experiment`).
+    ``env_record``: a model's recorded env (meta.json's ``env``), registered again if this process
+    lacks it."""
+    if name in EXPERIMENT_MODULES:
+        return importlib.import_module(EXPERIMENT_MODULES[name]).EXPERIMENT
+    from rlcore import gym_experiment
+
+    if not gym_experiment.looks_like_gym_id(name):
+        raise UserError(f"unknown experiment {name!r}; choose one of {', '.join(EXPERIMENT_MODULES)}, "
+                        f"or a registered Gymnasium id such as CartPole-v1")
+    if env_record:
+        gym_experiment.register_from_record(env_record)
+    return gym_experiment.gym_experiment(name)

@@ -43,7 +43,7 @@ def load_policy(model_dir: str | Path, experiment: str | None = None, algo: str 
         if wanted is not None and meta.get(key) != wanted:
             raise UserError(f"model in {model_dir} is {meta.get('experiment')} {meta.get('algo')}, "
                             f"not {experiment} {algo}")
-    exp = get_experiment(meta["experiment"])
+    exp = get_experiment(meta["experiment"], meta.get("env"))
     spec = exp.algo(meta["algo"])
     if spec.kind not in POLICY_FILES:
         raise UserError(f"no policy loader for algorithm kind {spec.kind!r}")

@@ -2,6 +2,9 @@
 
     spec = build_spec("lunar_lander", "dqn", seed=0, overrides={"lr": 5e-4}, run_dir=Path("runs/x"))
     model_dir = run_training(spec, on_progress=lambda row, table: ...)
+    model_dir, meta = train_and_evaluate(spec)    # the same, then the final evaluation (main.py train)
+
+The Python API (:mod:`rlcore.api`) wraps these for notebooks and scripts.
 
 ``build_spec`` turns names, a preset and overrides into a checked :class:`RunSpec` (an invalid
 value is a :class:`UserError` before any folder exists); with ``resume`` it takes the
@@ -65,3 +68,46 @@ def run_training(spec: RunSpec, on_progress: Callable[[dict, str], None] | None 
     trainer = importlib.import_module(f"rlcore.trainers.{spec.kind}")
     with hold_run_folder(spec.run_dir):  # one writer per run folder (a second one is refused here)
         return trainer.train(spec)
+
+
+def budget_overrides(episodes: int | None, steps: int | None, given: dict | None = None) -> dict:
+    """``episodes`` / ``steps`` (``--episodes`` / ``--steps``) as the config fields they set; ``given``:
+    the hyperparameters set beside them, where ``max_episodes`` and ``episodes`` together would be two
+    answers to one question (a :class:`UserError`)."""
+    budget = {"max_episodes": episodes, "max_env_steps": steps}
+    for name, value in budget.items():
+        if value is not None and name in (given or {}):
+            short = "--episodes" if name == "max_episodes" else "--steps"
+            raise UserError(f"{short} and --{name.replace('_', '-')} set the same budget: give one")
+    return {name: value for name, value in budget.items() if value is not None}
+
+
+def check_new_run_dir(run_dir: Path) -> None:
+    """A new run may not start in a folder that holds one: it would append to its tables and
+    overwrite its checkpoint."""
+    from rlcore.trainers.spec import CHECKPOINT_FILE
+
+    held = [name for name in (CHECKPOINT_FILE, "metrics.csv") if (Path(run_dir) / name).is_file()]
+    if held:
+        raise UserError(f"--run-dir {run_dir} already holds a run ({held[0]}); continue it with --resume "
+                        f"{run_dir}, or give another --run-dir")
+
+
+def train_and_evaluate(spec: RunSpec, final_eval_episodes: int | None = None,
+                       on_progress: Callable[[dict, str], None] | None = None,
+                       say: Callable[[str], None] = print) -> tuple[Path, dict]:
+    """What ``main.py train`` and :func:`rlcore.api.train` both run: :func:`run_training`, then the
+    final evaluation on unseen seeds recorded in meta.json (``final_eval_episodes``: None = the
+    experiment's default, 0 = none). Returns the model folder and its meta.json."""
+    import json
+
+    from rlcore import shipping
+
+    model_dir = run_training(spec, on_progress)
+    meta = json.loads((model_dir / "meta.json").read_text())
+    say(f"trained: {meta['episodes']} episodes, {meta['env_steps']} env steps, "
+        f"{meta['wall_seconds']:.0f} s; last-100 average {meta['final_average']:.1f}")
+    episodes = shipping.eval_episodes(spec.experiment, final_eval_episodes)
+    if episodes > 0:
+        meta = shipping.evaluate_into_meta(model_dir, episodes)
+    return model_dir, meta

@@ -44,7 +44,7 @@ def model_from_checkpoint(run_dir: str | Path, out_dir: str | Path, experiment: 
     if (state.get("experiment"), state.get("algo")) != (experiment, algo):
         raise UserError(f"the run in {run_dir} is {state.get('experiment')} {state.get('algo')}, "
                         f"not {experiment} {algo}")
-    exp = get_experiment(state["experiment"])
+    exp = get_experiment(state["experiment"], state.get("env"))
     cfg = config_from_meta(exp, state)
     env = exp.env_factory(cfg, max_episode_steps=None)()
     agent = _agent(exp.algo(state["algo"]).kind, env.observation_space, env.action_space, cfg)
@@ -52,7 +52,7 @@ def model_from_checkpoint(run_dir: str | Path, out_dir: str | Path, experiment: 
     load_checkpoint(run_dir / CHECKPOINT_FILE, agent.models(), {})
     agent.save(out_dir)
     meta = {key: state[key] for key in ("experiment", "algo", "kind", "preset", "seed", "config", "env_steps",
-                                        "commands") if key in state}
+                                        "commands", "env") if key in state}
     meta.update(episodes=len(state.get("returns", [])), snapshot_of=str(run_dir / CHECKPOINT_FILE))
     write_json(out_dir / "meta.json", meta)
     return meta

@@ -1,7 +1,8 @@
 """PPO with a shared CNN feature, a softmax policy head and a value head (article 001).
 
 The network reads ``uint8`` frame stacks and scales them to [0, 1] itself, so frames cross the
-env pool as bytes. It outputs policy logits (pi = softmax(logits)) and V(s).
+env pool as bytes. It outputs policy logits (pi = softmax(logits)) and V(s). On vector observations
+(any Gymnasium env with a 1-D Box) two tanh MLPs, one per output, stand in for the CNN.
 
 One update is one compiled call: GAE over the [T, N] rollout, then ``epochs`` passes of shuffled
 minibatches (the shuffles come from the trainer's numpy RNG, so a resumed run replays exactly).
@@ -39,7 +40,40 @@ MODEL_FILE = "actor_critic.h5"
 _QUIRK_EPS = 1e-3  # the article's constant in pi / (pi_old + 1e-3) and log(pi + 1e-3)
 
 
-def build_actor_critic(obs_shape: tuple, n_actions: int, precision: str = "float32") -> keras.Model:
+def is_image(obs_shape: tuple) -> bool:
+    """Frame stacks (H x W x C, uint8) go through the CNN; anything flat through the MLPs."""
+    return len(obs_shape) == 3
+
+
+def obs_dtype(obs_shape: tuple) -> np.dtype:
+    return np.dtype(np.uint8) if is_image(obs_shape) else np.dtype(np.float32)
+
+
+def build_actor_critic(obs_shape: tuple, n_actions: int, precision: str = "float32",
+                       hidden: tuple[int, ...] = (64, 64)) -> keras.Model:
+    """Images: :func:`build_cnn_actor_critic`; vector observations: :func:`build_mlp_actor_critic`."""
+    if is_image(tuple(obs_shape)):
+        return build_cnn_actor_critic(tuple(obs_shape), n_actions, precision)
+    return build_mlp_actor_critic(tuple(obs_shape), n_actions, hidden)
+
+
+def build_mlp_actor_critic(obs_shape: tuple, n_actions: int, hidden: tuple[int, ...]) -> keras.Model:
+    """Vector observations: two separate tanh MLPs in one model (as CleanRL's and SB3's PPO on
+    classic control), so the value loss does not pull on the policy's features. Outputs
+    ``[logits, value]`` like the CNN model."""
+    obs = keras.Input(obs_shape, dtype="float32", name="obs")
+    tower = {}
+    for head in ("policy", "value"):
+        x = obs
+        for i, units in enumerate(hidden):
+            x = layers.Dense(units, activation="tanh", name=f"{head}_hidden_{i}")(x)
+        tower[head] = x
+    logits = layers.Dense(n_actions, name="policy_logits")(tower["policy"])
+    value = layers.Dense(1, name="value")(tower["value"])
+    return keras.Model(obs, [logits, value], name="actor_critic")
+
+
+def build_cnn_actor_critic(obs_shape: tuple, n_actions: int, precision: str = "float32") -> keras.Model:
     """Feature: 4 x Conv2D(32, 3, stride 2, same, ReLU) -> Flatten -> Dense 512; then two heads.
 
     ``precision="bfloat16"`` makes the feature layers compute in bfloat16 (Keras's mixed_bfloat16
@@ -104,21 +138,22 @@ class PPOAgent:
 
     def __init__(self, obs_shape: tuple, n_actions: int, cfg: PPOConfig):
         self.obs_shape, self.n_actions, self.cfg = tuple(obs_shape), n_actions, cfg
-        self.model = build_actor_critic(self.obs_shape, n_actions, cfg.precision)
+        self.model = build_actor_critic(self.obs_shape, n_actions, cfg.precision, cfg.hidden)
+        self.obs_dtype = obs_dtype(self.obs_shape)  # frames stay uint8 up to the model
         self.opt = keras.optimizers.Adam(cfg.lr)
         self.opt.build(self.model.trainable_variables)
-        frames = tf.TensorSpec([None, *self.obs_shape], tf.uint8)
+        frames = tf.TensorSpec([None, *self.obs_shape], tf.as_dtype(self.obs_dtype))
         self._forward = tf.function(lambda obs: self.model(obs), input_signature=[frames])
         t, n = cfg.n_steps, cfg.num_envs
         vec = tf.TensorSpec([t, n], tf.float32)
         self._update = tf.function(self._update_graph, input_signature=[
-            tf.TensorSpec([t, n, *self.obs_shape], tf.uint8), tf.TensorSpec([t, n], tf.int32),
+            tf.TensorSpec([t, n, *self.obs_shape], tf.as_dtype(self.obs_dtype)), tf.TensorSpec([t, n], tf.int32),
             vec, vec, vec, vec, vec, vec, tf.TensorSpec([cfg.epochs, t * n], tf.int32)])
 
     # ----------------------------------------------------------------- acting
     def policy_and_values(self, obs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(pi(.|s) [B, A], V(s) [B]) for a batch of frame stacks."""
-        logits, values = self._forward(np.asarray(obs, np.uint8))
+        """(pi(.|s) [B, A], V(s) [B]) for a batch of observations (frame stacks or vectors)."""
+        logits, values = self._forward(np.asarray(obs, self.obs_dtype))
         return softmax(logits.numpy()), values.numpy()[:, 0]
 
     def act(self, obs: np.ndarray, rng: np.random.Generator):

@@ -3,7 +3,7 @@ for experiments with a goal (Mario's flag), which episodes reached it."""
 from __future__ import annotations
 
 import numpy as np
-from tqdm import tqdm
+from tqdm.auto import tqdm  # a widget in a notebook, text in a terminal
 
 
 def episode_means(reports: list[dict], names: tuple[str, ...]) -> dict[str, float]:

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import keras
 import numpy as np
-from tqdm import tqdm
+from tqdm.auto import tqdm  # a widget in a notebook, text in a terminal
 
 from rlcore.agents.ppo import MODEL_FILE, UPDATE_NAMES, PPOAgent
 from rlcore.cpu import bfloat16_note, cpu_flags
@@ -29,8 +29,8 @@ from rlcore.vector import EnvPool
 class Rollout:
     """Preallocated [T, N] buffers of one rollout (frames stay uint8)."""
 
-    def __init__(self, t: int, n: int, obs_shape: tuple):
-        self.obs = np.zeros((t, n, *obs_shape), np.uint8)
+    def __init__(self, t: int, n: int, obs_shape: tuple, obs_dtype=np.uint8):
+        self.obs = np.zeros((t, n, *obs_shape), obs_dtype)
         self.actions = np.zeros((t, n), np.int32)
         (self.logp, self.values, self.next_values, self.rewards, self.terminated,
          self.dones) = (np.zeros((t, n), np.float32) for _ in range(6))
@@ -78,7 +78,7 @@ def train(spec: RunSpec) -> Path:
                          **lr.state())
 
     t, n = cfg.n_steps, cfg.num_envs
-    buf = Rollout(t, n, obs_shape)
+    buf = Rollout(t, n, obs_shape, agent.obs_dtype)
     running = np.zeros(n)
     losses = {name: float("nan") for name in UPDATE_NAMES}  # CSV columns exist from the first row
     # a resumed run starts fresh episodes, reseeded from its episode count

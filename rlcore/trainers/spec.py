@@ -2,6 +2,8 @@
 and the check that a checkpoint belongs to the run that wants to resume it."""
 from __future__ import annotations
 
+import glob
+import re
 import shlex
 import sys
 from dataclasses import dataclass, field
@@ -42,17 +44,26 @@ class RunSpec:
         """What the run is, as CSV headers, checkpoints and meta.json record it."""
         from rlcore.hparams import to_dict
 
+        env = getattr(self.experiment, "env_record", None)  # a Gymnasium id's registration
         return {"experiment": self.experiment.name, "algo": self.algo, "kind": self.kind,
-                "preset": self.preset, "seed": self.seed, "config": to_dict(self.config)}
+                "preset": self.preset, "seed": self.seed, "config": to_dict(self.config),
+                **({"env": env} if env else {})}
+
+
+def folder_safe(name: str) -> str:
+    """``name`` as one folder or file name: ``ALE/Pong-v5`` -> ``ALE_Pong-v5``, ``my_envs:Maze-v0`` ->
+    ``my_envs_Maze-v0`` (a Gymnasium id can hold a namespace and a module)."""
+    return re.sub(r"[^\w.-]", "_", name)
 
 
 def new_run_dir(experiment: str, algo: str, seed: int) -> Path:
     stamp = datetime.now().strftime("%Y%m%d-%H%M%S")
-    return RUNS_DIR / f"{experiment}__{algo}__{seed}__{stamp}"
+    return RUNS_DIR / f"{folder_safe(experiment)}__{algo}__{seed}__{stamp}"
 
 
 def latest_run_dir(experiment: str, algo: str) -> Path:
-    runs = sorted(RUNS_DIR.glob(f"{experiment}__{algo}__*/{CHECKPOINT_FILE}"), key=lambda p: p.stat().st_mtime)
+    runs = sorted(RUNS_DIR.glob(f"{glob.escape(folder_safe(experiment))}__{algo}__*/{CHECKPOINT_FILE}"),
+                  key=lambda p: p.stat().st_mtime)
     if not runs:
         raise UserError(f"no run of {experiment} {algo} with a checkpoint under {RUNS_DIR}/ to resume")
     return runs[-1].parent

@@ -13,7 +13,7 @@ import threading
 import time
 from pathlib import Path
 
-from tqdm import tqdm
+from tqdm.auto import tqdm  # a widget in a notebook, text in a terminal
 
 
 # each asks for a stop at the next safe point, with a checkpoint

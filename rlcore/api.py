@@ -1,0 +1,333 @@
+"""The Python API: what ``main.py`` does, from a notebook or a script, with the same records.
+
+    import rlcore
+
+    run = rlcore.train("Acrobot-v1", "dqn", episodes=200, lr=5e-4)     # any Gymnasium id, or an experiment
+    run.evaluation["mean"]                                              # the final unseen-seed evaluation
+    policy = rlcore.load(("lunar_lander", "dqn"))                       # a shipped model, or any model folder
+    action = policy.predict(observation)
+    rlcore.evaluate(policy, episodes=20)                                # -> dict, as `main.py evaluate`
+    rlcore.render(policy, "lander.gif")                                 # MP4 or GIF
+    rlcore.export(run, "onnx", "exports/acrobot")                       # checked against the Keras model
+
+:func:`train` runs what ``main.py train`` runs (:func:`rlcore.run.train_and_evaluate`): the same
+checked hyperparameters, run folder, checkpoints, CSV tables and model folder, and the same final
+evaluation on unseen seeds written into meta.json, whose ``command`` records this call. A mistake
+the user can fix raises :class:`UserError` (one line, as the CLI prints it). TensorFlow is imported
+on the first call that needs it, with its start-up noise dropped; progress bars are widgets in a
+notebook (``tqdm.auto``).
+"""
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Callable, Iterator, Literal, Union
+
+os.environ.setdefault("TF_CPP_MIN_LOG_LEVEL", "2")  # before anything imports TensorFlow, as main.py does
+import numpy as np
+
+from rlcore.errors import UserError
+from rlcore.experiment import Experiment
+
+if TYPE_CHECKING:
+    import gymnasium
+
+__all__ = ["train", "load", "evaluate", "render", "export", "Run", "Policy", "ModelRef", "ProgressCallback",
+           "Experiment", "UserError"]
+
+#: a model: a folder (a model folder, a finished run's folder, or a run in progress), a finished
+#: :class:`Run`, or a shipped model by name: ``("lunar_lander", "dqn")``, ``("mario_ppo", "1-1")``
+ModelRef = Union[str, "os.PathLike[str]", tuple[str, str], "Run"]
+#: ``callback(row, table)``: every row the run logs, as it is logged; ``table`` is ``"metrics"`` (one
+#: row per episode), ``"evals"`` (periodic evaluations) or ``"rollouts"`` (PPO: one row per update)
+ProgressCallback = Callable[[dict[str, Any], str], None]
+ExportFormat = Literal["savedmodel", "tflite", "onnx"]
+WandbMode = Literal["auto", "online", "offline", "off"]
+
+
+@dataclass(frozen=True)
+class Run:
+    """A finished training run: its folder, its model folder and the model's meta.json."""
+    run_dir: Path
+    model_dir: Path
+    meta: dict[str, Any] = field(repr=False)
+
+    @property
+    def evaluation(self) -> dict[str, Any] | None:
+        """The final evaluation on unseen seeds (meta.json's ``evaluation``), None when skipped."""
+        return self.meta.get("evaluation")
+
+    @property
+    def command(self) -> str:
+        """The call that started the run, as meta.json records it."""
+        return str(self.meta["command"])
+
+    def load(self) -> Policy:
+        """The trained policy (:func:`load` of :attr:`model_dir`)."""
+        return load(self.model_dir)
+
+
+class Policy:
+    """A saved model, ready to act: ``predict(observation) -> action``.
+
+    ``experiment`` is what the model was trained on (its env factory, evaluation seeds); ``meta`` its
+    meta.json; ``make_env()`` builds its env as it was evaluated (time limit, Mario's level, SAC's
+    rescaled actions).
+    """
+
+    def __init__(self, model_dir: Path, experiment: Experiment, meta: dict[str, Any], network: Any,
+                 keep: Any = None):
+        self.model_dir, self.experiment, self.meta = model_dir, experiment, meta
+        self.algo: str = str(meta["algo"])
+        self.kind: str = experiment.algo(self.algo).kind
+        self._network = network  # rlcore.policies.Policy / MeanActionPolicy: batched acting
+        self._keep = keep  # a run in progress: the temporary folder of its snapshot, kept with the policy
+
+    def __repr__(self) -> str:
+        return f"Policy({self.experiment.name} {self.algo}, {self.model_dir})"
+
+    @property
+    def observation_shape(self) -> tuple[int, ...]:
+        return tuple(self._network.model.input_shape[1:])
+
+    def make_env(self, render_mode: str | None = None) -> gymnasium.Env:
+        """The model's env (``render_mode="rgb_array"`` for frames)."""
+        env: gymnasium.Env = self._network.make_env(render_mode=render_mode)
+        return env
+
+    def predict(self, observation: Any, deterministic: bool = True,
+                rng: np.random.Generator | None = None) -> Any:
+        """The action for one observation (an int, or for SAC an array in [-1, 1] that the env rescales),
+        or an array of actions for a batch of observations.
+
+        ``deterministic``: the greedy action (argmax of Q or pi; SAC's mean action), as ``evaluate``
+        plays (Mario's evaluation samples from pi: pass ``deterministic=False``); else a draw from pi
+        with ``rng`` (the DQN family has no distribution to draw from).
+        """
+        obs = np.asarray(observation)
+        single = obs.shape == self.observation_shape
+        batch = obs[None] if single else obs
+        if batch.shape[1:] != self.observation_shape:
+            raise UserError(f"observation of shape {obs.shape} given; this model takes "
+                            f"{self.observation_shape} (or a batch of them)")
+        actions = self._network(batch) if deterministic else self._sample(batch, rng or np.random.default_rng())
+        return actions[0].item() if single and actions.ndim == 1 else (actions[0] if single else actions)
+
+    def _sample(self, batch: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        if self.kind == "sac":
+            out = self._network.scores(batch)
+            dim = out.shape[1] // 2
+            config = self.meta.get("config", {})
+            log_std = np.clip(out[:, dim:], config.get("log_std_min", -20.0), config.get("log_std_max", 2.0))
+            draw = out[:, :dim] + np.exp(log_std) * rng.standard_normal(out[:, :dim].shape)
+            return np.tanh(draw).astype(np.float32)
+        sampled: np.ndarray = self._network.sample(batch, rng)
+        return sampled
+
+    def __call__(self, observations: np.ndarray) -> np.ndarray:
+        """Greedy actions for a batch (the interface rlcore's evaluation and video code call)."""
+        actions: np.ndarray = self._network(observations)
+        return actions
+
+
+# ------------------------------------------------------------------------------- train
+def train(env: str, algo: str, *, preset: str | None = None, seed: int = 0,
+          run_dir: str | os.PathLike[str] | None = None, episodes: int | None = None,
+          steps: int | None = None, final_eval_episodes: int | None = None, wandb: WandbMode = "off",
+          progress: bool = True, callback: ProgressCallback | None = None, **hyperparameters: Any) -> Run:
+    """Train ``algo`` on ``env`` and evaluate it as ``main.py train`` does; return the :class:`Run`.
+
+    ``env``: an experiment of this package (``"lunar_lander"``), any registered Gymnasium id whose
+    spaces fit ``algo`` (``"Acrobot-v1"``), or ``"my_module:MyEnv-v0"`` to import the module that
+    registers it first. ``preset``: a named set of hyperparameters (default ``"default"``; for a
+    Gymnasium id the algorithm's defaults). ``episodes`` / ``steps``: the budget (``max_episodes`` /
+    ``max_env_steps``). ``final_eval_episodes``: episodes on unseen seeds after training (None: the
+    experiment's default, 100; 0: none). ``run_dir``: where the run writes (default
+    ``runs/ENV__ALGO__SEED__TIME``). ``hyperparameters``: any field of the algorithm's config, e.g.
+    ``lr=5e-4, hidden=(128, 128)``; each is checked as the CLI checks it. ``callback(row, table)``
+    sees every logged row. ``progress``: the progress bar and the summary lines.
+    """
+    from rlcore.quiet import load_tensorflow
+    from rlcore.run import budget_overrides, build_spec, check_new_run_dir, train_and_evaluate
+    from rlcore.trainers.spec import new_run_dir
+
+    from rlcore.extras import require_experiment
+
+    require_experiment(env)  # a missing extra (mario, minitaur): one line, before any folder exists
+    load_tensorflow()
+    given = {name: tuple(value) if isinstance(value, list) else value for name, value in hyperparameters.items()}
+    overrides = {**given, **budget_overrides(episodes, steps, given)}
+    folder = Path(run_dir) if run_dir is not None else new_run_dir(env, algo, seed)
+    check_new_run_dir(folder)
+    command = _call("train", [env, algo], dict(preset=preset, seed=seed, run_dir=run_dir, episodes=episodes,
+                                                 steps=steps, final_eval_episodes=final_eval_episodes,
+                                                 **hyperparameters))
+    spec = build_spec(env, algo, preset=preset, seed=seed, overrides=overrides, run_dir=folder,
+                      wandb_mode=wandb, progress=progress, command=command)
+    say: Callable[[str], None] = print if progress else (lambda line: None)
+    say(f"training {spec.experiment.name} {spec.algo} ({spec.preset} preset, seed {spec.seed}) -> {folder}")
+    with _quiet_unless(progress):
+        model_dir, meta = train_and_evaluate(spec, final_eval_episodes, on_progress=callback, say=say)
+    return Run(folder, model_dir, meta)
+
+
+def _call(name: str, args: list[Any], kwargs: dict[str, Any]) -> str:
+    """``rlcore.train('Acrobot-v1', 'dqn', seed=0, lr=0.0005)``: the call, as meta.json's command
+    (defaults left out, paths as strings)."""
+    defaults = {"preset": None, "run_dir": None, "episodes": None, "steps": None, "final_eval_episodes": None}
+    shown = [repr(a) for a in args] + [f"{k}={str(v)!r}" if isinstance(v, os.PathLike) else f"{k}={v!r}"
+                                       for k, v in kwargs.items() if not (k in defaults and v is None)]
+    return f"rlcore.{name}({', '.join(shown)})"
+
+
+@contextlib.contextmanager
+def _quiet_unless(loud: bool) -> Iterator[None]:
+    """With ``progress=False``, the trainer's per-rollout lines and the evaluation line go nowhere."""
+    if loud:
+        yield
+        return
+    import io
+    from contextlib import redirect_stdout
+
+    from tqdm.auto import tqdm
+
+    write = tqdm.write
+    tqdm.write = lambda *args, **kwargs: None  # type: ignore[method-assign]
+    try:
+        with redirect_stdout(io.StringIO()):
+            yield
+    finally:
+        tqdm.write = write  # type: ignore[method-assign]
+
+
+# ------------------------------------------------------------------------------- load
+def model_folder(model: str | os.PathLike[str] | tuple[str, str]) -> Path:
+    """The folder of ``model``: a shipped name (``("lunar_lander", "dqn")``, Mario's ``("mario_ppo",
+    "1-1")``), or a path (a finished run's folder stands for its ``model/``). A run in progress is
+    returned as it is (:func:`load` reads its last checkpoint)."""
+    from rlcore import shipping
+    from rlcore.experiment import get_experiment
+
+    if isinstance(model, tuple):
+        if len(model) != 2 or not all(isinstance(part, str) for part in model):
+            raise UserError(f"a shipped model is named (EXPERIMENT, ALGO or LEVEL), e.g. ('lunar_lander', 'dqn'); "
+                            f"got {model!r}")
+        name, which = model
+        exp = get_experiment(name)
+        if which in exp.algos or not exp.ship_by:
+            exp.algo(which)  # an unknown algorithm: one line naming the known ones
+            folder = shipping.shipped_dir(name, which)
+        else:
+            folder = shipping.SAVED_NETWORKS / name / which
+        if not (folder / "meta.json").is_file():
+            shipped = sorted(p.parent.name for p in (shipping.SAVED_NETWORKS / name).glob("*/meta.json"))
+            raise UserError(f"no shipped model {name} {which} in {shipping.SAVED_NETWORKS}; shipped: "
+                            f"{', '.join(shipped) or 'none'} (or give a model folder)")
+        return folder
+    folder = Path(model)
+    finished = folder / "model"
+    if (finished / "meta.json").is_file() and not (folder / "meta.json").is_file():
+        return finished
+    return folder
+
+
+def load(model: ModelRef | Policy) -> Policy:
+    """The :class:`Policy` of ``model`` (see :data:`ModelRef`), rebuilt from its folder alone: its
+    meta.json names the env (a Gymnasium id's registration included) and the network."""
+    from rlcore.policies import load_policy
+    from rlcore.quiet import load_tensorflow
+    from rlcore.snapshot import is_run_in_progress, model_from_checkpoint
+
+    if isinstance(model, Policy):
+        return model
+    if isinstance(model, Run):
+        model = model.model_dir
+    folder = model_folder(model)
+    load_tensorflow()
+    keep = None
+    source = folder
+    if is_run_in_progress(folder):
+        from rlcore.checkpoint import read_checkpoint_state
+        from rlcore.trainers.spec import CHECKPOINT_FILE
+
+        state = read_checkpoint_state(folder / CHECKPOINT_FILE)
+        keep = tempfile.TemporaryDirectory(prefix="snapshot-")
+        model_from_checkpoint(folder, keep.name, state["experiment"], state["algo"])
+        source = Path(keep.name)
+    exp, meta, network = load_policy(source)
+    return Policy(folder, exp, meta, network, keep)
+
+
+# ---------------------------------------------------------------------- evaluate, render
+def evaluate(model: ModelRef | Policy, episodes: int | None = None, seed_base: int | None = None,
+             record: bool = False) -> dict[str, Any]:
+    """Evaluate on unseen seeds as ``main.py evaluate`` does (episode i seeded ``seed_base + i``,
+    default the experiment's evaluation range; ``episodes`` default 100, Mario 10): greedy
+    mean/std/min of the return and per-episode records, or for Mario the share of episodes that
+    reached the flag. ``line`` holds the one-line report. ``record``: also write it into the model
+    folder's meta.json as its evaluation."""
+    from rlcore import shipping
+
+    policy = load(model)
+    count = shipping.eval_episodes(policy.experiment, episodes)
+    if count < 1:
+        raise UserError(f"episodes must be at least 1, not {count}")
+    if record:
+        meta = shipping.evaluate_into_meta(policy.model_dir, count, seed_base)
+        policy.meta = meta
+        return dict(meta["evaluation"])
+    summary, line = shipping.run_evaluation(policy.experiment, policy._network, count, seed_base)
+    return {**summary, "line": line}
+
+
+def render(model: ModelRef | Policy, out: str | os.PathLike[str] = "video.mp4", episodes: int | None = None,
+           seed: int | None = None, fps: int | None = None) -> Path:
+    """Film ``episodes`` episodes (default the experiment's, 1; Minitaur 3) into ``out``: an ``.mp4``,
+    or a small looping ``.gif``. Episode i is seeded ``seed + i`` (default the first evaluation seed).
+    Returns the path written."""
+    from rlcore.atomic import writable_folder
+    from rlcore.video import check_video_path
+
+    path = check_video_path(out)
+    policy = load(model)
+    writable_folder(path.parent, "out")
+    render_policy(policy, path, fps, episodes, seed)
+    return path
+
+
+def render_policy(policy: Policy, out: Path, fps: int | None, episodes: int | None,
+                  seed: int | None) -> dict[str, Any]:
+    """Write the video; return :func:`rlcore.video.record_video`'s record (frames, returns ...)."""
+    from rlcore.video import record_video
+
+    exp, network = policy.experiment, policy._network
+    count = exp.episodes_per_video if episodes is None else episodes
+    act = network.sample if exp.success_key else None  # Mario plays as it was evaluated
+    result: dict[str, Any] = record_video(exp, network, out, fps or exp.video_fps, count, seed,
+                                          make_env=network.make_env, act=act)
+    return result
+
+
+def export(model: ModelRef | Policy, format: ExportFormat, out: str | os.PathLike[str],
+           observations: int = 256) -> dict[str, Any]:
+    """Export the acting network as a TF SavedModel, a TFLite file or an ONNX file into the folder
+    ``out`` and check it against the Keras model (:func:`rlcore.export.export_model`); return the
+    record written to ``out/export.json``. Needs the export extra for tflite and onnx."""
+    from rlcore.export import export_model
+    from rlcore.quiet import load_tensorflow
+
+    policy = load(model)
+    load_tensorflow()
+    with _snapshot_folder(policy) as folder:
+        record: dict[str, Any] = export_model(folder, format, out, observations=observations,
+                                              source=str(policy.model_dir))
+    return record
+
+
+@contextlib.contextmanager
+def _snapshot_folder(policy: Policy) -> Iterator[Path]:
+    """The folder that holds the policy's files (a run in progress: its snapshot)."""
+    yield Path(policy._keep.name) if policy._keep is not None else policy.model_dir

@@ -1,0 +1,178 @@
+"""Any Gymnasium id trains without an experiment package (issue 47): Acrobot-v1 (dqn, a2c, ppo),
+Pendulum-v1 (sac), CartPole-v1 (ppo) and a user's own registered env, each a short run end to end
+(train, final evaluation, load, evaluate; render and export on some), and a mismatch of env and
+algorithm is one line and exit status 2 before any run folder exists."""
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import main
+import rlcore
+from rlcore.errors import UserError
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def cli(capsys, *argv):
+    try:
+        code = main.main(list(argv))
+    except SystemExit as exc:  # argparse
+        code = exc.code
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def check_run(run, env_id, algo, eval_episodes):
+    """What every finished run must hold: the env recorded, the evaluation, a loadable policy."""
+    meta = json.loads((run.model_dir / "meta.json").read_text())
+    assert meta == run.meta
+    assert (meta["experiment"], meta["algo"], meta["preset"]) == (env_id, algo, "default")
+    assert meta["env"]["gymnasium_id"] == env_id.rpartition(":")[2]
+    assert meta["command"].startswith(f"rlcore.train({env_id!r}, {algo!r}")
+    assert run.evaluation["episodes"] == eval_episodes and len(run.evaluation["per_episode"]) == eval_episodes
+    assert run.evaluation["seeds"].startswith("1000000..")  # unseen seeds, as main.py train
+    policy = rlcore.load(run.run_dir)  # a finished run's folder stands for its model
+    env = policy.make_env()
+    obs, _ = env.reset(seed=3)
+    action = policy.predict(obs)
+    assert env.action_space.contains(np.asarray(action, env.action_space.dtype).reshape(env.action_space.shape))
+    batch = policy.predict(np.stack([obs, obs, obs]))
+    assert len(batch) == 3
+    env.close()
+    return policy
+
+
+@pytest.mark.parametrize("algo, budget", [
+    ("dqn", dict(episodes=2, hidden=(32, 32))),
+    ("a2c", dict(episodes=2, actor_hidden=(32,), critic_hidden=(32,))),
+    ("ppo", dict(steps=1024, num_envs=2, n_steps=256, epochs=2, minibatch=256)),
+])
+def test_acrobot(tmp_path, algo, budget):
+    run = rlcore.train("Acrobot-v1", algo, run_dir=tmp_path / "run", final_eval_episodes=2, progress=False,
+                       **budget)
+    policy = check_run(run, "Acrobot-v1", algo, 2)
+    assert run.meta["config"]["max_episode_steps"] == 0  # the registered limit (500)
+    assert max(r["length"] for r in run.evaluation["per_episode"]) <= 500
+    result = rlcore.evaluate(policy, episodes=2, seed_base=5)
+    assert result["seeds"] == "5..6" and result["episodes"] == 2 and "greedy return" in result["line"]
+
+
+def test_pendulum_sac_rescales_actions(tmp_path):
+    run = rlcore.train("Pendulum-v1", "sac", run_dir=tmp_path / "run", steps=400, learning_starts=200,
+                       batch_size=32, actor_hidden=(32, 32), critic_hidden=(32, 32), final_eval_episodes=2,
+                       progress=False)
+    policy = check_run(run, "Pendulum-v1", "sac", 2)
+    assert run.meta["env"]["actions_rescaled_to"] == [-1, 1]
+    env = policy.make_env()
+    assert (env.action_space.low, env.action_space.high) == (-1.0, 1.0)  # the actor's range
+    assert env.unwrapped.action_space.high[0] == 2.0  # Pendulum's own torque bound, reached at +1
+    sampled = policy.predict(env.reset(seed=0)[0], deterministic=False, rng=np.random.default_rng(0))
+    assert sampled.shape == (1,) and -1.0 <= sampled[0] <= 1.0
+    env.close()
+
+
+def test_cartpole_ppo_cli_evaluate_render_export(tmp_path, capsys):
+    run_dir = tmp_path / "run"
+    code, out, err = cli(capsys, "train", "CartPole-v1", "ppo", "--steps", "1024", "--num-envs", "4",
+                         "--n-steps", "128", "--minibatch", "128", "--epochs", "2", "--hidden", "32,32",
+                         "--final-eval-episodes", "3", "--run-dir", str(run_dir), "--wandb", "off",
+                         "--no-progress")
+    assert code == 0, err
+    assert "evaluation (unseen seeds): greedy return" in out
+    meta = json.loads((run_dir / "model" / "meta.json").read_text())
+    assert meta["experiment"] == "CartPole-v1" and meta["config"]["hidden"] == [32, 32]
+    assert meta["command"].startswith("python ") and "train CartPole-v1 ppo" in meta["command"]
+    assert meta["evaluation"]["episodes"] == 3
+    code, out, err = cli(capsys, "evaluate", "CartPole-v1", "ppo", "--model", str(run_dir), "--episodes", "2")
+    assert code == 0, err
+    assert "CartPole-v1 ppo" in out and "over 2 episodes" in out
+    gif = rlcore.render(run_dir, tmp_path / "cartpole.gif")
+    assert gif.stat().st_size > 0
+    record = rlcore.export(run_dir, "savedmodel", tmp_path / "export", observations=32)
+    assert record["experiment"] == "CartPole-v1" and record["kind"] == "ppo"
+    assert (tmp_path / "export" / "export.json").is_file()
+
+
+def test_user_env_module_trains_learns_and_loads_in_a_fresh_process(tmp_path):
+    """``MODULE:ID`` imports the user's module (which registers its env); the model folder alone
+    rebuilds the env later, in a process that never imported that module. PPO's MLP body learns it."""
+    run = rlcore.train("tests.user_env:Chase-v0", "ppo", run_dir=tmp_path / "run", steps=6144, num_envs=4,
+                       n_steps=64, minibatch=64, epochs=4, lr=3e-3, entropy_coef=0.0, final_eval_episodes=10,
+                       progress=False)
+    check_run(run, "tests.user_env:Chase-v0", "ppo", 10)
+    assert run.evaluation["mean"] >= 17.0, run.evaluation  # random play scores ~10 of 20
+    code = ("import rlcore, gymnasium; assert 'Chase-v0' not in gymnasium.registry; "
+            f"print(rlcore.evaluate({str(run.model_dir)!r}, episodes=3)['mean'])")
+    done = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True,
+                          timeout=120, env={**os.environ, "PYTHONPATH": str(ROOT)})
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert float(done.stdout.strip().splitlines()[-1]) >= 17.0
+
+
+def test_registered_by_id_alone_reloads_from_its_record(tmp_path, capsys):
+    """An env registered in the training process (a notebook) under a string entry point: the CLI's
+    evaluate finds it from the model's meta.json in a new process."""
+    import tests.user_env  # noqa: F401  registers Chase-v0 here, as a notebook would
+
+    run = rlcore.train("Chase-v0", "dqn", run_dir=tmp_path / "run", episodes=3, final_eval_episodes=0,
+                       progress=False)
+    assert run.evaluation is None  # final_eval_episodes=0: none, as --final-eval-episodes 0
+    done = subprocess.run([sys.executable, str(ROOT / "main.py"), "evaluate", "Chase-v0", "dqn", "--model",
+                           str(run.run_dir), "--episodes", "2"], cwd=tmp_path, capture_output=True, text=True,
+                          timeout=120)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert "Chase-v0 dqn" in done.stdout and "over 2 episodes" in done.stdout
+
+
+@pytest.mark.parametrize("env_id, algo, message", [
+    ("Acrobot-v1", "sac", "error: sac does not fit Acrobot-v1: it needs continuous actions (a 1-D Box), and the "
+                          "env's are Discrete(3); algorithms that fit it: dqn, ddqn, dueling_dqn, dueling_ddqn, "
+                          "a2c, ppo"),
+    ("Pendulum-v1", "dqn", "error: dqn does not fit Pendulum-v1: it needs discrete actions"),
+    ("CarRacing-v3", "dqn", "error: dqn does not fit CarRacing-v3: it needs discrete actions"),
+    ("FrozenLake-v1", "ppo", "error: ppo does not fit FrozenLake-v1: it needs vector observations (a 1-D Box) "
+                             "or uint8 images"),
+    ("NoSuchEnv-v0", "dqn", "error: NoSuchEnv-v0 is not a registered Gymnasium id"),
+    ("no_such_module:Thing-v0", "dqn", "error: cannot import 'no_such_module'"),
+])
+def test_mismatch_is_one_line_and_exit_2(tmp_path, capsys, env_id, algo, message):
+    code, out, err = cli(capsys, "train", env_id, algo, "--run-dir", str(tmp_path / "run"), "--steps", "10")
+    assert code == 2
+    assert err.startswith(message) and err.count("\n") == 1, err
+    assert not (tmp_path / "run").exists()
+    with pytest.raises(UserError, match=message.removeprefix("error: ")[:30]):
+        rlcore.train(env_id, algo, run_dir=tmp_path / "run", steps=10)
+    assert not (tmp_path / "run").exists()
+
+
+def test_image_env_with_dqn_names_what_dqn_needs(tmp_path):
+    """An image env with discrete actions: PPO's CNN fits, the DQN family does not."""
+    from rlcore.experiment import get_experiment
+
+    gym.register("ImageSign-v0", entry_point="tests.toy:ImageSignEnv")
+    try:
+        exp = get_experiment("ImageSign-v0")
+        assert list(exp.algos) == ["ppo"]
+        with pytest.raises(UserError, match=r"^dqn does not fit ImageSign-v0: it needs vector observations "
+                                            r"\(a 1-D Box\), and the env's are Box\(0, 255, \(8, 8, 2\), uint8\); "
+                                            r"algorithms that fit it: ppo$"):
+            exp.algo("dqn")
+    finally:
+        del gym.registry["ImageSign-v0"]
+
+
+def test_every_hyperparameter_is_a_flag_and_checked(capsys):
+    code, out, err = cli(capsys, "train", "Acrobot-v1", "ppo", "--help")
+    assert code == 0
+    for flag in ("--hidden", "--lr", "--n-steps", "--gae-lambda", "--clip"):
+        assert flag in out
+    code, out, err = cli(capsys, "train", "Acrobot-v1", "dqn", "--gamma", "1.5")
+    assert code == 2 and "--gamma" in err and err.count("\n") == 1
+    with pytest.raises(UserError, match="unknown hyperparameter"):
+        rlcore.train("Acrobot-v1", "dqn", learning_rate=1e-3)
