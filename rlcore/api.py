@@ -168,7 +168,7 @@ def train(env: str, algo: str, *, preset: str | None = None, seed: int = 0,
     spec = build_spec(env, algo, preset=preset, seed=seed, overrides=overrides, run_dir=folder,
                       wandb_mode=wandb, progress=progress, command=command)
     say: Callable[[str], None] = print if progress else (lambda line: None)
-    say(f"training {spec.experiment.name} {spec.algo} ({spec.preset} preset, seed {spec.seed}) -> {folder}")
+    say(f"training {env} {algo} ({spec.preset} preset, seed {spec.seed}) -> {folder}")
     with _quiet_unless(progress):
         model_dir, meta = train_and_evaluate(spec, final_eval_episodes, on_progress=callback, say=say)
     return Run(folder, model_dir, meta)
@@ -195,12 +195,12 @@ def _quiet_unless(loud: bool) -> Iterator[None]:
     from tqdm.auto import tqdm
 
     write = tqdm.write
-    tqdm.write = lambda *args, **kwargs: None  # type: ignore[method-assign]
+    tqdm.write = lambda *args, **kwargs: None
     try:
         with redirect_stdout(io.StringIO()):
             yield
     finally:
-        tqdm.write = write  # type: ignore[method-assign]
+        tqdm.write = write
 
 
 # ------------------------------------------------------------------------------- load
@@ -291,7 +291,7 @@ def render(model: ModelRef | Policy, out: str | os.PathLike[str] = "video.mp4", 
     from rlcore.atomic import writable_folder
     from rlcore.video import check_video_path
 
-    path = check_video_path(out)
+    path = check_video_path(Path(out))
     policy = load(model)
     writable_folder(path.parent, "out")
     render_policy(policy, path, fps, episodes, seed)

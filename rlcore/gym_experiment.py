@@ -23,12 +23,17 @@ import dataclasses
 import importlib
 import re
 from functools import partial
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from rlcore.configs import A2CConfig, DQNConfig, PPOConfig, SACConfig
 from rlcore.errors import UserError
 from rlcore.experiment import AlgoSpec, Experiment
+
+if TYPE_CHECKING:
+    import gymnasium
+    from gymnasium.envs.registration import EnvSpec
 
 #: algorithm name -> (trainer kind, description, config switches)
 ALGORITHMS: dict[str, tuple[str, str, dict]] = {
@@ -57,7 +62,7 @@ def split_module(name: str) -> tuple[str | None, str]:
     return module or None, env_id
 
 
-def gym_spec(name: str):
+def gym_spec(name: str) -> EnvSpec:
     """The registered :class:`gymnasium.envs.registration.EnvSpec` of ``name`` (importing its module
     first for ``module:id``), or a one-line :class:`UserError`."""
     import gymnasium as gym
@@ -91,7 +96,7 @@ def register_from_record(record: dict) -> None:
 
 
 def make_gym_env(render_mode: str | None = None, max_episode_steps: int | None = None, *, name: str,
-                 rescale_actions: bool = False):
+                 rescale_actions: bool = False) -> gymnasium.Env:
     """The env ``name`` (``module:id`` imports the module first) with its registered time limit unless
     ``max_episode_steps`` is given; SAC's envs get their Box actions rescaled from [-1, 1]."""
     import gymnasium as gym
@@ -106,19 +111,19 @@ def make_gym_env(render_mode: str | None = None, max_episode_steps: int | None =
 
 
 # ---------------------------------------------------------------- what fits
-def _vector(space) -> bool:
+def _vector(space: gymnasium.Space) -> bool:
     from gymnasium import spaces
 
     return isinstance(space, spaces.Box) and len(space.shape) == 1
 
 
-def _image(space) -> bool:
+def _image(space: gymnasium.Space) -> bool:
     from gymnasium import spaces
 
     return isinstance(space, spaces.Box) and len(space.shape) == 3 and space.dtype == np.uint8
 
 
-def misfit(kind: str, observation_space, action_space) -> str | None:
+def misfit(kind: str, observation_space: gymnasium.Space, action_space: gymnasium.Space) -> str | None:
     """Why an algorithm of ``kind`` cannot train on these spaces (one clause), or None when it can."""
     from gymnasium import spaces
 
@@ -138,7 +143,7 @@ def misfit(kind: str, observation_space, action_space) -> str | None:
     return None
 
 
-def default_preset(kind: str, switches: dict, reward_threshold: float | None):
+def default_preset(kind: str, switches: dict, reward_threshold: float | None) -> object:
     """The algorithm's config defaults, for an env this package knows nothing of."""
     fields = dict(max_episode_steps=0, stop_score=(NO_THRESHOLD_STOP if reward_threshold is None
                                                     else float(reward_threshold)), **switches)
