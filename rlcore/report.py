@@ -69,7 +69,8 @@ def probability_of_improvement(x: np.ndarray, y: np.ndarray) -> float:
 
 # --------------------------------------------------------------------------------- run folders
 def load_runs(sweep_dir: Path) -> list[dict]:
-    """One row per run folder of a sweep: trial, final score, env steps, wall time (finished only)."""
+    """One row per run folder of a sweep: trial, final score, env steps, wall time and the CPU it ran
+    on (finished runs only)."""
     sweep_dir = Path(sweep_dir)
     if not sweep_dir.is_dir():
         raise UserError(f"no sweep folder {sweep_dir}")
@@ -83,6 +84,7 @@ def load_runs(sweep_dir: Path) -> list[dict]:
         rows.append({"trial": meta_path.parent.parent.name, "seed": meta["seed"], "score": float(score),
                      "eval_episodes": ev.get("episodes"), "env_steps": meta["env_steps"],
                      "wall_seconds": meta["wall_seconds"], "run_dir": meta_path.parent.parent,
+                     "cpu": meta.get("cpu"),
                      "what": f"{meta.get('experiment')} {meta.get('algo')}"})
     if not rows:
         raise UserError(f"{sweep_dir} holds no finished, evaluated run (model/meta.json with an evaluation)")
@@ -165,10 +167,11 @@ def markdown(result: dict) -> str:
     lines = []
     for s in result["sweeps"]:
         lines += [f"## {s['label']} ({s['folder']})", "",
-                  "| run | seed | final score (unseen seeds) | env steps | wall |",
-                  "| --- | ---: | ---: | ---: | ---: |"]
+                  "| run | seed | final score (unseen seeds) | env steps | wall | env steps/s | CPU |",
+                  "| --- | ---: | ---: | ---: | ---: | ---: | --- |"]
         lines += [f"| {r['trial']} | {r['seed']} | {r['score']:.3f} | {r['env_steps']:,} "
-                  f"| {r['wall_seconds']:.0f} s |" for r in s["runs"]]
+                  f"| {r['wall_seconds']:.0f} s | {r['env_steps'] / max(r['wall_seconds'], 1e-9):,.0f} "
+                  f"| {r.get('cpu') or 'not recorded'} |" for r in s["runs"]]
         lines += ["", f"| over {len(s['runs'])} runs | point | 95% CI (stratified bootstrap) |",
                   "| --- | ---: | --- |"]
         lines += [f"| {name} | {p:.3f} | [{lo:.3f}, {hi:.3f}] |" for name, (p, lo, hi) in s["aggregates"].items()]
