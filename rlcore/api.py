@@ -1,14 +1,14 @@
 """The Python API: what ``main.py`` does, from a notebook or a script, with the same records.
 
-    import rlcore
+    from rlcore import api
 
-    run = rlcore.train("Acrobot-v1", "dqn", episodes=200, lr=5e-4)     # any Gymnasium id, or an experiment
+    run = api.train("Acrobot-v1", "dqn", episodes=200, lr=5e-4)        # any Gymnasium id, or an experiment
     run.evaluation["mean"]                                              # the final unseen-seed evaluation
-    policy = rlcore.load(("lunar_lander", "dqn"))                       # a shipped model, or any model folder
+    policy = api.load(("lunar_lander", "dqn"))                          # a shipped model, or any model folder
     action = policy.predict(observation)
-    rlcore.evaluate(policy, episodes=20)                                # -> dict, as `main.py evaluate`
-    rlcore.render(policy, "lander.gif")                                 # MP4 or GIF
-    rlcore.export(run, "onnx", "exports/acrobot")                       # checked against the Keras model
+    api.evaluate(policy, episodes=20)                                   # -> dict, as `main.py evaluate`
+    api.render(policy, "lander.gif")                                    # MP4 or GIF
+    api.export(run, "onnx", "exports/acrobot")                          # checked against the Keras model
 
 :func:`train` runs what ``main.py train`` runs (:func:`rlcore.run.train_and_evaluate`): the same
 checked hyperparameters, run folder, checkpoints, CSV tables and model folder, and the same final
@@ -175,12 +175,12 @@ def train(env: str, algo: str, *, preset: str | None = None, seed: int = 0,
 
 
 def _call(name: str, args: list[Any], kwargs: dict[str, Any]) -> str:
-    """``rlcore.train('Acrobot-v1', 'dqn', seed=0, lr=0.0005)``: the call, as meta.json's command
+    """``rlcore.api.train('Acrobot-v1', 'dqn', seed=0, lr=0.0005)``: the call, as meta.json's command
     (defaults left out, paths as strings)."""
     defaults = {"preset": None, "run_dir": None, "episodes": None, "steps": None, "final_eval_episodes": None}
     shown = [repr(a) for a in args] + [f"{k}={str(v)!r}" if isinstance(v, os.PathLike) else f"{k}={v!r}"
                                        for k, v in kwargs.items() if not (k in defaults and v is None)]
-    return f"rlcore.{name}({', '.join(shown)})"
+    return f"rlcore.api.{name}({', '.join(shown)})"
 
 
 @contextlib.contextmanager

@@ -1,4 +1,4 @@
-"""The Python API end to end (rlcore.train/load/evaluate/render/export) and the notebook docs/api.ipynb,
+"""The Python API end to end (api.train/load/evaluate/render/export) and the notebook docs/api.ipynb,
 executed as a user would run it (nbclient, a real Jupyter kernel)."""
 import json
 import os
@@ -7,14 +7,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import rlcore
+from rlcore import api
 from rlcore.errors import UserError
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def test_shipped_model_by_name_predicts_and_evaluates():
-    policy = rlcore.load(("lunar_lander", "dqn"))
+    policy = api.load(("lunar_lander", "dqn"))
     assert policy.algo == "dqn" and policy.experiment.name == "lunar_lander"
     assert policy.model_dir == ROOT / "saved_networks" / "lunar_lander" / "dqn"
     env = policy.make_env()
@@ -23,7 +23,7 @@ def test_shipped_model_by_name_predicts_and_evaluates():
     assert isinstance(action, int) and 0 <= action < 4
     assert policy.predict(np.stack([obs] * 5)).shape == (5,)
     env.close()
-    result = rlcore.evaluate(policy, episodes=2, seed_base=1_000_000)
+    result = api.evaluate(policy, episodes=2, seed_base=1_000_000)
     recorded = policy.meta["evaluation"]["per_episode"][:2]  # the same seeds the shipped evaluation played
     assert [r["seed"] for r in result["per_episode"]] == [r["seed"] for r in recorded]
     assert result["episodes"] == 2 and result["line"].startswith("greedy return")
@@ -31,9 +31,9 @@ def test_shipped_model_by_name_predicts_and_evaluates():
 
 def test_mario_level_by_name():
     pytest.importorskip("nes_py", reason="the mario extra is not installed")
-    policy = rlcore.load(("mario_ppo", "1-1"))
+    policy = api.load(("mario_ppo", "1-1"))
     assert policy.model_dir.name == "1-1" and policy.meta["config"]["stage"] == 1
-    assert rlcore.load(("mario_ppo", "ppo")).model_dir.name == "1-1"  # the default level
+    assert api.load(("mario_ppo", "ppo")).model_dir.name == "1-1"  # the default level
 
 
 @pytest.mark.parametrize("model, message", [
@@ -46,31 +46,31 @@ def test_load_mistakes_are_user_errors(model, message):
     if model[0] == "mario_ppo":
         pytest.importorskip("nes_py", reason="the mario extra is not installed")
     with pytest.raises(UserError, match=message):
-        rlcore.load(model)
+        api.load(model)
 
 
 def test_train_records_the_call_evaluates_and_renders(tmp_path):
     rows = []
-    run = rlcore.train("cartpole", "dqn", run_dir=tmp_path / "run", episodes=4, final_eval_episodes=3, seed=2,
+    run = api.train("cartpole", "dqn", run_dir=tmp_path / "run", episodes=4, final_eval_episodes=3, seed=2,
                        progress=False, callback=lambda row, table: rows.append((table, row)), lr=5e-4)
     meta = json.loads((run.model_dir / "meta.json").read_text())
-    assert meta["command"] == (f"rlcore.train('cartpole', 'dqn', seed=2, run_dir={str(tmp_path / 'run')!r}, "
+    assert meta["command"] == (f"rlcore.api.train('cartpole', 'dqn', seed=2, run_dir={str(tmp_path / 'run')!r}, "
                                f"episodes=4, final_eval_episodes=3, lr=0.0005)")
     assert meta["config"]["lr"] == 5e-4 and meta["seed"] == 2 and meta["config"]["max_episodes"] == 4
     # the same final evaluation as main.py train: unseen seeds, written into meta.json
     assert meta["evaluation"]["episodes"] == 3 and meta["evaluation"]["seeds"] == "1000000..1000002"
     assert run.evaluation == meta["evaluation"]
     assert [table for table, _ in rows] == ["metrics"] * 4 and rows[-1][1]["episode"] == 4
-    video = rlcore.render(run, tmp_path / "clip.mp4", episodes=1)
+    video = api.render(run, tmp_path / "clip.mp4", episodes=1)
     import imageio.v2 as imageio
     with imageio.get_reader(video) as reader:  # decoded by ffmpeg (imageio-ffmpeg)
         assert video == tmp_path / "clip.mp4" and reader.count_frames() > 1
     with pytest.raises(UserError, match="already holds a run"):
-        rlcore.train("cartpole", "dqn", run_dir=tmp_path / "run", episodes=1)
+        api.train("cartpole", "dqn", run_dir=tmp_path / "run", episodes=1)
     with pytest.raises(UserError, match="--episodes and --max-episodes set the same budget"):
-        rlcore.train("cartpole", "dqn", run_dir=tmp_path / "other", episodes=1, max_episodes=2)
+        api.train("cartpole", "dqn", run_dir=tmp_path / "other", episodes=1, max_episodes=2)
     with pytest.raises(UserError, match="give a file name ending in .mp4 or .gif"):
-        rlcore.render(run, tmp_path / "clip.avi")
+        api.render(run, tmp_path / "clip.avi")
 
 
 def test_a_run_in_progress_loads_from_its_checkpoint(tmp_path):
@@ -82,9 +82,9 @@ def test_a_run_in_progress_loads_from_its_checkpoint(tmp_path):
     run_training(spec)
     import shutil
     shutil.rmtree(tmp_path / "run" / "model")  # as if it had not finished
-    policy = rlcore.load(tmp_path / "run")
+    policy = api.load(tmp_path / "run")
     assert policy.meta["snapshot_of"].endswith("checkpoint.npz")
-    assert rlcore.evaluate(policy, episodes=1)["episodes"] == 1
+    assert api.evaluate(policy, episodes=1)["episodes"] == 1
 
 
 def test_notebook_runs(tmp_path, monkeypatch):
@@ -101,7 +101,7 @@ def test_notebook_runs(tmp_path, monkeypatch):
     assert not [o for o in outputs if o.output_type == "error"]
     text = "\n".join(o.get("text", "") + json.dumps(o.get("data", {}).get("text/plain", ""))
                      for o in outputs)
-    assert "greedy return" in text and "rlcore.train('CartPole-v1', 'ppo'" in text
+    assert "greedy return" in text and "rlcore.api.train('CartPole-v1', 'ppo'" in text
     assert (tmp_path / "runs" / "notebook_cartpole_ppo" / "model" / "meta.json").is_file()
     for noise in ("cuInit", "oneDNN custom operations", "absl::InitializeLog"):
         assert noise not in text  # TensorFlow's start-up noise is kept out

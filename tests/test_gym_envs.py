@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import main
-import rlcore
+from rlcore import api
 from rlcore.errors import UserError
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -34,10 +34,10 @@ def check_run(run, env_id, algo, eval_episodes):
     assert meta == run.meta
     assert (meta["experiment"], meta["algo"], meta["preset"]) == (env_id, algo, "default")
     assert meta["env"]["gymnasium_id"] == env_id.rpartition(":")[2]
-    assert meta["command"].startswith(f"rlcore.train({env_id!r}, {algo!r}")
+    assert meta["command"].startswith(f"rlcore.api.train({env_id!r}, {algo!r}")
     assert run.evaluation["episodes"] == eval_episodes and len(run.evaluation["per_episode"]) == eval_episodes
     assert run.evaluation["seeds"].startswith("1000000..")  # unseen seeds, as main.py train
-    policy = rlcore.load(run.run_dir)  # a finished run's folder stands for its model
+    policy = api.load(run.run_dir)  # a finished run's folder stands for its model
     env = policy.make_env()
     obs, _ = env.reset(seed=3)
     action = policy.predict(obs)
@@ -54,17 +54,17 @@ def check_run(run, env_id, algo, eval_episodes):
     ("ppo", dict(steps=1024, num_envs=2, n_steps=256, epochs=2, minibatch=256)),
 ])
 def test_acrobot(tmp_path, algo, budget):
-    run = rlcore.train("Acrobot-v1", algo, run_dir=tmp_path / "run", final_eval_episodes=2, progress=False,
+    run = api.train("Acrobot-v1", algo, run_dir=tmp_path / "run", final_eval_episodes=2, progress=False,
                        **budget)
     policy = check_run(run, "Acrobot-v1", algo, 2)
     assert run.meta["config"]["max_episode_steps"] == 0  # the registered limit (500)
     assert max(r["length"] for r in run.evaluation["per_episode"]) <= 500
-    result = rlcore.evaluate(policy, episodes=2, seed_base=5)
+    result = api.evaluate(policy, episodes=2, seed_base=5)
     assert result["seeds"] == "5..6" and result["episodes"] == 2 and "greedy return" in result["line"]
 
 
 def test_pendulum_sac_rescales_actions(tmp_path):
-    run = rlcore.train("Pendulum-v1", "sac", run_dir=tmp_path / "run", steps=400, learning_starts=200,
+    run = api.train("Pendulum-v1", "sac", run_dir=tmp_path / "run", steps=400, learning_starts=200,
                        batch_size=32, actor_hidden=(32, 32), critic_hidden=(32, 32), final_eval_episodes=2,
                        progress=False)
     policy = check_run(run, "Pendulum-v1", "sac", 2)
@@ -92,9 +92,9 @@ def test_cartpole_ppo_cli_evaluate_render_export(tmp_path, capsys):
     code, out, err = cli(capsys, "evaluate", "CartPole-v1", "ppo", "--model", str(run_dir), "--episodes", "2")
     assert code == 0, err
     assert "CartPole-v1 ppo" in out and "over 2 episodes" in out
-    gif = rlcore.render(run_dir, tmp_path / "cartpole.gif")
+    gif = api.render(run_dir, tmp_path / "cartpole.gif")
     assert gif.stat().st_size > 0
-    record = rlcore.export(run_dir, "savedmodel", tmp_path / "export", observations=32)
+    record = api.export(run_dir, "savedmodel", tmp_path / "export", observations=32)
     assert record["experiment"] == "CartPole-v1" and record["kind"] == "ppo"
     assert (tmp_path / "export" / "export.json").is_file()
 
@@ -102,13 +102,13 @@ def test_cartpole_ppo_cli_evaluate_render_export(tmp_path, capsys):
 def test_user_env_module_trains_learns_and_loads_in_a_fresh_process(tmp_path):
     """``MODULE:ID`` imports the user's module (which registers its env); the model folder alone
     rebuilds the env later, in a process that never imported that module. PPO's MLP body learns it."""
-    run = rlcore.train("tests.user_env:Chase-v0", "ppo", run_dir=tmp_path / "run", steps=6144, num_envs=4,
+    run = api.train("tests.user_env:Chase-v0", "ppo", run_dir=tmp_path / "run", steps=6144, num_envs=4,
                        n_steps=64, minibatch=64, epochs=4, lr=3e-3, entropy_coef=0.0, final_eval_episodes=10,
                        progress=False)
     check_run(run, "tests.user_env:Chase-v0", "ppo", 10)
     assert run.evaluation["mean"] >= 17.0, run.evaluation  # random play scores ~10 of 20
-    code = ("import rlcore, gymnasium; assert 'Chase-v0' not in gymnasium.registry; "
-            f"print(rlcore.evaluate({str(run.model_dir)!r}, episodes=3)['mean'])")
+    code = ("from rlcore import api; import gymnasium; assert 'Chase-v0' not in gymnasium.registry; "
+            f"print(api.evaluate({str(run.model_dir)!r}, episodes=3)['mean'])")
     done = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True,
                           timeout=120, env={**os.environ, "PYTHONPATH": str(ROOT)})
     assert done.returncode == 0, done.stderr[-2000:]
@@ -120,7 +120,7 @@ def test_registered_by_id_alone_reloads_from_its_record(tmp_path, capsys):
     evaluate finds it from the model's meta.json in a new process."""
     import tests.user_env  # noqa: F401  registers Chase-v0 here, as a notebook would
 
-    run = rlcore.train("Chase-v0", "dqn", run_dir=tmp_path / "run", episodes=3, final_eval_episodes=0,
+    run = api.train("Chase-v0", "dqn", run_dir=tmp_path / "run", episodes=3, final_eval_episodes=0,
                        progress=False)
     assert run.evaluation is None  # final_eval_episodes=0: none, as --final-eval-episodes 0
     done = subprocess.run([sys.executable, str(ROOT / "main.py"), "evaluate", "Chase-v0", "dqn", "--model",
@@ -147,7 +147,7 @@ def test_mismatch_is_one_line_and_exit_2(tmp_path, capsys, env_id, algo, message
     assert err.startswith(message) and err.count("\n") == 1, err
     assert not (tmp_path / "run").exists()
     with pytest.raises(UserError, match=message.removeprefix("error: ")[:30]):
-        rlcore.train(env_id, algo, run_dir=tmp_path / "run", steps=10)
+        api.train(env_id, algo, run_dir=tmp_path / "run", steps=10)
     assert not (tmp_path / "run").exists()
 
 
@@ -175,4 +175,4 @@ def test_every_hyperparameter_is_a_flag_and_checked(capsys):
     code, out, err = cli(capsys, "train", "Acrobot-v1", "dqn", "--gamma", "1.5")
     assert code == 2 and "--gamma" in err and err.count("\n") == 1
     with pytest.raises(UserError, match="unknown hyperparameter"):
-        rlcore.train("Acrobot-v1", "dqn", learning_rate=1e-3)
+        api.train("Acrobot-v1", "dqn", learning_rate=1e-3)
