@@ -180,10 +180,11 @@ def test_every_help_page_prints(capsys, argv):
         assert all(name in out for name in main.COMMANDS)
 
 
-@pytest.mark.parametrize("signal_name", ["SIGINT", "SIGTERM"])
+@pytest.mark.parametrize("signal_name", ["SIGINT"])
 def test_ctrl_c_saves_a_checkpoint_and_resume_continues(tmp_path, signal_name):
-    """A real SIGINT (Ctrl-C) or SIGTERM (kill) to a real training process: exit 130, checkpoint
-    written, resume continues."""
+    """A real SIGINT (Ctrl-C) to a real training process of the episode loop (DQN): exit 130, checkpoint
+    written, resume continues. SIGTERM, and both signals to a whole process group with an env pool:
+    tests/test_stop_signals.py (the same handler takes both)."""
     import signal
     import time
 

@@ -10,6 +10,7 @@ on; it says so in one line.
 """
 from __future__ import annotations
 
+import contextlib
 import sys
 from pathlib import Path
 
@@ -43,14 +44,19 @@ def save(session: TrainingSession, agent, rng: np.random.Generator, memory: Repl
          env_arrays: dict | None = None, **counters) -> None:
     """Write the checkpoint (and the replay memory first, stamped with the same env step count);
     ``env_arrays``: what the envs kept (:func:`env_memory`); ``counters``: the trainer's own
-    (epsilon, grad_steps, rollouts, ...)."""
-    if memory is not None:
-        with atomic_path(session.run_dir / REPLAY_FILE) as tmp, open(tmp, "wb") as f:
-            np.savez(f, env_steps=np.array(session.env_steps), **memory.state_dict())
-        counters["replay_env_steps"] = session.env_steps
-    save_checkpoint(session.checkpoint_path, agent.models(), agent.optimizers(),
-                    session.state(rng=rng.bit_generator.state, **counters),
-                    {**session.best_arrays(), **(env_arrays or {})})
+    (epsilon, grad_steps, rollouts, ...).
+
+    Both files are written in full before either replaces its predecessor, so a full disk while writing
+    either leaves the last good pair in place; the replay memory is moved in after the checkpoint."""
+    with contextlib.ExitStack() as pending:
+        if memory is not None:
+            replay_tmp = pending.enter_context(atomic_path(session.run_dir / REPLAY_FILE))
+            with open(replay_tmp, "wb") as f:
+                np.savez(f, env_steps=np.array(session.env_steps), **memory.state_dict())
+            counters["replay_env_steps"] = session.env_steps
+        save_checkpoint(session.checkpoint_path, agent.models(), agent.optimizers(),
+                        session.state(rng=rng.bit_generator.state, **counters),
+                        {**session.best_arrays(), **(env_arrays or {})})
 
 
 def env_memory(envs, name: str | None) -> dict:
