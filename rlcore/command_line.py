@@ -116,16 +116,7 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
                                     "(Mario: share of episodes reaching the flag, x position)"),
                        ("render", "an MP4 or GIF of a saved model playing (greedily; Mario samples from pi)")):
         p = sub.add_parser(name, help=text, description=text)
-        p.add_argument("experiment", help=f"one of {', '.join(experiment_names())}, or the Gymnasium id a "
-                                          "--model was trained on")
-        p.add_argument("algo", help="an algorithm of the experiment (`list` shows them)")
-        p.add_argument("--model", default=None,
-                       help="model folder, a finished run's folder, or a run in progress (its last "
-                            "checkpoint) (default saved_networks/EXPERIMENT/ALGO)")
-        p.add_argument("--world", type=whole_number(WORLD), default=None,
-                       help="Mario: the shipped model of this world (default 1)")
-        p.add_argument("--stage", type=whole_number(STAGE), default=None,
-                       help="Mario: the shipped model of this stage (default 1)")
+        _add_model_choice(p, experiment_names())
         if name == "evaluate":
             p.add_argument("--episodes", type=EVAL_EPISODES, default=None, help="default 100; Mario 10")
             p.add_argument("--seed-base", type=NON_NEGATIVE, default=None,
@@ -149,16 +140,8 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
                     "loaded by its own runtime, against the Keras model on observations from the "
                     "experiment's env on evaluation seeds. OUT gets the file and export.json; a failed "
                     "check is one line, exit status 2, and OUT is left as it was. See docs/export.md.")
-    export.add_argument("experiment")
-    export.add_argument("algo")
+    _add_model_choice(export, experiment_names())
     export.add_argument("--format", required=True, choices=["savedmodel", "tflite", "onnx"])
-    export.add_argument("--model", default=None,
-                        help="model folder, a finished run's folder, or a run in progress (its last "
-                             "checkpoint) (default saved_networks/EXPERIMENT/ALGO)")
-    export.add_argument("--world", type=whole_number(WORLD), default=None,
-                        help="Mario: the shipped model of this world (default 1)")
-    export.add_argument("--stage", type=whole_number(STAGE), default=None,
-                        help="Mario: the shipped model of this stage (default 1)")
     export.add_argument("--out", default=None, metavar="OUT",
                         help="the export folder, new or an earlier export (default "
                              "exports/EXPERIMENT_ALGO_FORMAT)")
@@ -237,6 +220,21 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
     docs.add_argument("--check", action="store_true",
                       help="write nothing; exit 1 listing every file that differs from what would be written")
     return parser
+
+
+def _add_model_choice(p: argparse.ArgumentParser, experiments: list[str]) -> None:
+    """EXPERIMENT ALGO and which of its models: --model, or Mario's --world/--stage (evaluate, render,
+    export)."""
+    p.add_argument("experiment", help=f"one of {', '.join(experiments)}, or the Gymnasium id a --model was "
+                                      "trained on")
+    p.add_argument("algo", help="an algorithm of the experiment (`list` shows them)")
+    p.add_argument("--model", default=None,
+                   help="model folder, a finished run's folder, or a run in progress (its last "
+                        "checkpoint) (default saved_networks/EXPERIMENT/ALGO)")
+    p.add_argument("--world", type=whole_number(WORLD), default=None,
+                   help="Mario: the shipped model of this world (default 1)")
+    p.add_argument("--stage", type=whole_number(STAGE), default=None,
+                   help="Mario: the shipped model of this stage (default 1)")
 
 
 class _Unparsable(Exception):

@@ -12,20 +12,11 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-import main
+from tests.test_cli import run as cli
 from rlcore import api
 from rlcore.errors import UserError
 
 ROOT = Path(__file__).resolve().parents[1]
-
-
-def cli(capsys, *argv):
-    try:
-        code = main.main(list(argv))
-    except SystemExit as exc:  # argparse
-        code = exc.code
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 def check_run(run, env_id, algo, eval_episodes):

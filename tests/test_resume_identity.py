@@ -5,18 +5,9 @@ import json
 import numpy as np
 import pytest
 
-import main
+from tests.test_cli import run
 from rlcore.experiment import get_experiment
 from rlcore.hparams import defining_fields, to_dict
-
-
-def run(capsys, *argv):
-    try:
-        code = main.main(list(argv))
-    except SystemExit as exc:  # argparse
-        code = exc.code
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 def fake_run(folder, experiment: str, algo: str, preset: str = "default", seed: int = 0, **changes):
