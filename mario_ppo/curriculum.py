@@ -69,7 +69,7 @@ class StepBack:
 
 
 def lend_routes(per_env: list[dict], config) -> list[dict]:
-    """What each env of a resumed pool gets (``Experiment.share_env_memory``): with a stepping restart
+    """What each env of a resumed pool gets (``Curriculum.share_memory``): with a stepping restart
     x (the routes hold :data:`X_KEY`), the envs still at the run's ``restart_x`` (whose restarts never
     got past the goal often enough to step back) take the routes and x of the envs that stepped back,
     in turn; the others keep their own."""

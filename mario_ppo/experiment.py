@@ -17,7 +17,7 @@ from mario_ppo.restarts import KEEPS, WEIGHTS
 from rlcore.allowed import OFF_OR_COUNT, Allowed, choices, require
 from rlcore import extras
 from rlcore.configs import PPOConfig
-from rlcore.experiment import AlgoSpec, Bar, Experiment
+from rlcore.experiment import AlgoSpec, Bar, Curriculum, Experiment, Goal, ShippedBy
 
 
 @dataclass(frozen=True)
@@ -153,15 +153,21 @@ EXPERIMENT = Experiment(
     video_fps=60,
     env_fields=("world", "stage", "actions", "score_reward", "stall_steps", "stall_outcome",
                 "frames", "dead_ends"),
-    train_env_fields=("restart_x", "restart_every", "restart_share", "restart_weights", "restart_keep",
-                      "restart_back_step", "restart_goal_x", "restart_back_share"),
     bars={level: Bar("success_share", 0.8 if level == "1-1" else 0.5,
                      "article 001 reached the flag on every level from 1-1 to 2-4 but 1-3; we ask it in at "
                      "least 5 of 10 unseen-seed episodes on each level, and 8 of 10 on 1-1, the first level") for level in LEVEL_NAMES},
-    success_key="flag_get", progress_key="x_pos", partial_key="restarted", partial_start_key="start_x",
-    env_memory="restart_routes", share_env_memory=lend_routes,
-    info_keys=("stalled", "start_x", "killed_by"), cause_key="killed_by", cause_name=cause_name,
-    eval_episodes=10, ship_by=("world", "stage"), default_model="1-1", score_label="return (shaped, /10)",
+    info_keys=("stalled", "start_x", "killed_by"),
+    eval_episodes=10, score_label="return (shaped, /10)",
+    # the flag is the goal; x_pos how far Mario got; killed_by what ended a failed episode
+    goal=Goal(success_key="flag_get", progress_key="x_pos", cause_key="killed_by", cause_name=cause_name),
+    # restarts (training only): restarted episodes start at start_x; the routes to each kept restart
+    # point are kept by checkpoints and lent between envs on resume
+    curriculum=Curriculum(
+        env_fields=("restart_x", "restart_every", "restart_share", "restart_weights", "restart_keep",
+                    "restart_back_step", "restart_goal_x", "restart_back_share"),
+        partial_key="restarted", partial_start_key="start_x",
+        memory="restart_routes", share_memory=lend_routes),
+    shipped_by=ShippedBy(fields=("world", "stage"), default="1-1"),  # saved_networks/mario_ppo/1-1
 )
 
 extras.declare("mario_ppo", "Mario", "mario", ("cv2", "nes_py", "gym_super_mario_bros"))  # checked early

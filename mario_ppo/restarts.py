@@ -34,7 +34,7 @@ ends, a state it passed is kept where its reach is at least that of the state ke
 A single restart x can also step itself back towards the start as the restarts from it succeed, a
 backward curriculum by rule (``back_step``; :mod:`mario_ppo.curriculum` says how and why).
 
-Evaluation never uses it: both are training-only settings (``Experiment.train_env_fields``), so
+Evaluation never uses it: both are training-only settings (``Curriculum.env_fields``), so
 every evaluation and video starts at the level's start. Restarted episodes are marked
 (``info["restarted"]``) and left out of the flag share that the stop rule reads; ``info["start_x"]``
 says where each episode started (metrics.csv: which points are hard).

@@ -217,7 +217,7 @@ def model_folder(model: str | os.PathLike[str] | tuple[str, str]) -> Path:
                             f"got {model!r}")
         name, which = model
         exp = get_experiment(name)
-        if which in exp.algos or not exp.ship_by:
+        if which in exp.algos or exp.shipped_by is None:
             exp.algo(which)  # an unknown algorithm: one line naming the known ones
             folder = shipping.shipped_dir(name, which)
         else:
@@ -305,7 +305,7 @@ def render_policy(policy: Policy, out: Path, fps: int | None, episodes: int | No
 
     exp, network = policy.experiment, policy._network
     count = exp.episodes_per_video if episodes is None else episodes
-    act = network.sample if exp.success_key else None  # Mario plays as it was evaluated
+    act = network.sample if exp.goal else None  # Mario plays as it was evaluated
     result: dict[str, Any] = record_video(exp, network, out, fps or exp.video_fps, count, seed,
                                           make_env=network.make_env, act=act)
     return result

@@ -34,7 +34,7 @@ def cmd_list(args) -> int:
         exp = get_experiment(name)
         print(f"{name}: {exp.description}")
         for algo, spec in exp.algos.items():
-            folders = ([shipping.shipped_dir(name, algo)] if not exp.ship_by
+            folders = ([shipping.shipped_dir(name, algo)] if exp.shipped_by is None
                        else sorted((shipping.SAVED_NETWORKS / name).glob("*-*")))
             shipped = [shipping.shipped_summary(f) for f in folders if (f / "meta.json").is_file()]
             print(f"  {algo:<14} {spec.description:<24} presets: {', '.join(spec.presets):<25} "
@@ -103,7 +103,7 @@ def _model_dir(args) -> Path:
         return finished if (finished / "meta.json").is_file() and not (folder / "meta.json").is_file() else folder
     if level == (None, None):
         return shipping.shipped_dir(args.experiment, args.algo)
-    if not exp.ship_by:
+    if exp.shipped_by is None:
         raise UserError(f"--world/--stage choose a Mario level; {exp.name} ships one model per algorithm")
     if args.model:
         raise UserError("give either --model or --world/--stage, not both")

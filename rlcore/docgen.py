@@ -108,7 +108,7 @@ def shipped_models() -> list[Model]:
         if not root.is_dir():
             continue
         folders = sorted(p.parent for p in root.glob("*/meta.json"))
-        if not exp.ship_by:
+        if exp.shipped_by is None:
             order = list(exp.algos)
             folders.sort(key=lambda p: order.index(p.name) if p.name in order else len(order))
         for folder in folders:
@@ -136,10 +136,10 @@ def kept_sweeps() -> dict[tuple[str, str], Sweep]:
             continue
         folder = sweep_json.parent
         exp = get_experiment(sweep["experiment"])
-        if exp.ship_by:
+        if exp.shipped_by:
             preset = exp.preset(sweep["algo"], sweep.get("preset"))
             overrides = sweep.get("overrides") or {}
-            model = "-".join(str(overrides.get(f, getattr(preset, f))) for f in exp.ship_by)
+            model = "-".join(str(overrides.get(f, getattr(preset, f))) for f in exp.shipped_by.fields)
         else:
             model = sweep["algo"]
         seeds = []

@@ -91,9 +91,9 @@ def score_section(m: Model, page: str, docs: bool) -> str:
 def usage_section(m: Model) -> str:
     exp = get_experiment(m.experiment)
     where = ""
-    if exp.ship_by:
+    if exp.shipped_by:
         values = m.name.split("-")
-        where = "".join(f" --{f} {v}" for f, v in zip(exp.ship_by, values))
+        where = "".join(f" --{f} {v}" for f, v in zip(exp.shipped_by.fields, values))
     cmd = f"python main.py {{}} {m.experiment} {m.algo}{where}"
     return "\n".join([
         "```bash",

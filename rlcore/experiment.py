@@ -64,9 +64,75 @@ class Bar:
 
 
 @dataclass(frozen=True)
+class Goal:
+    """A task scored by an event, not by a return: an info key marks a successful episode.
+
+    With a goal the trainers log success per episode and the stop rule reads the success share;
+    evaluation counts successes and plays actions sampled from pi (a greedy policy would play one
+    deterministic trajectory), as do render and the export's parity check; videos count successes.
+    """
+    success_key: str  # an info key, true at the end of a successful episode (Mario: flag_get)
+    # an info key that measures how far an episode got (Mario: x_pos): logged per episode and per
+    # rollout, evaluated, and plotted (progress and endings plots)
+    progress_key: str | None = None
+    # an info key that says, as a number, what ended a failed episode (Mario: killed_by, a fall, the
+    # clock or an enemy), and the words for a number (Mario: mario_ppo.deaths.cause_name): the
+    # evaluation line counts its failures by cause, and a Deaths plot shows the causes' shares
+    cause_key: str | None = None
+    cause_name: Callable[[float], str] = str
+
+    def __post_init__(self) -> None:
+        if not self.success_key:
+            raise ValueError("a Goal needs the info key that marks success")
+
+
+@dataclass(frozen=True)
+class Curriculum:
+    """What the training env does that evaluation's does not (Mario: restarts further into the level).
+
+    Its fields reach only the trainer's env pool; episodes that start elsewhere train like any other
+    but are marked, and what the envs build up over episodes is kept by the checkpoint.
+    """
+    # config fields that make_env takes in training only (Mario: restart_x, restart_every, ...): the
+    # trainer's env pool gets them; evaluations, videos and saved models build the env without them
+    env_fields: tuple[str, ...] = ()
+    # an info key that marks an episode that did not start where evaluation starts (Mario: restarted):
+    # it trains like any other, but its success is left out of the success share the stop rule reads,
+    # and its return and progress out of the plots
+    partial_key: str | None = None
+    partial_start_key: str | None = None  # an info key: where a partial episode started (Mario: start_x)
+    # an attribute of the training env that it builds up over episodes, a dict of name -> array, which
+    # a checkpoint keeps and a resumed run's env pool gets back (Mario: restart_routes, the buttons that
+    # lead to each kept restart point); ignored when the env has no such attribute
+    memory: str | None = None
+    # share_memory(per_env, config) rewrites the memory a resumed pool hands out, one dict per env
+    # (Mario: mario_ppo.curriculum.lend_routes, envs whose restart x never stepped back take the
+    # routes of envs whose x did)
+    share_memory: Callable[[list[dict], object], list[dict]] | None = None
+
+
+@dataclass(frozen=True)
+class ShippedBy:
+    """Models shipped one per value of some config fields (Mario: one per level, world and stage),
+    not one per algorithm: saved_networks/EXPERIMENT/<the values joined by '-'>."""
+    fields: tuple[str, ...]  # the config fields (Mario: world, stage -> saved_networks/mario_ppo/1-1)
+    default: str  # the folder evaluate/render/load take when no value is given (Mario: 1-1)
+
+    def __post_init__(self) -> None:
+        if not self.fields:
+            raise ValueError("ShippedBy needs at least one config field")
+
+    def folder(self, values) -> str:
+        """The model folder's name for a config (or any object with the fields as attributes)."""
+        return "-".join(str(getattr(values, name)) for name in self.fields)
+
+
+@dataclass(frozen=True)
 class Experiment:
-    """What an experiment declares. Only the first five are required; the rest say how it is
-    evaluated, shipped, plotted and filmed when it differs from a return-scored gymnasium task."""
+    """What an experiment declares. Only the first five are required (what a user writes for their
+    env); the rest say how it is evaluated, shipped, plotted and filmed when it differs from a
+    return-scored gymnasium task, and ``goal``, ``curriculum``, ``shipped_by`` are the typed
+    extensions of an experiment scored by an event (Mario's flag)."""
     name: str
     description: str
     make_env: Callable  # make_env(render_mode=None, max_episode_steps=None, **env_fields) -> gymnasium.Env
@@ -77,38 +143,10 @@ class Experiment:
     eval_episodes: int = 100  # episodes of the final evaluation on unseen seeds
     # config fields that make_env takes (Mario: world, stage, ...): recorded, so a model rebuilds its env
     env_fields: tuple[str, ...] = ()
-    # an info key that marks a successful episode (Mario: flag_get). With one, the trainer logs
-    # success per episode, evaluation counts successes and plays sampled actions, not greedy ones
-    success_key: str | None = None
-    progress_key: str | None = None  # an info key that measures progress (Mario: x_pos), logged and plotted
     # info keys whose value at an episode's end is kept per episode: in metrics.csv by the PPO and SAC
     # trainers, and in the evaluation's per-episode records (Mario: stalled, 1 when the stall limit
     # ended it; Minitaur: x, metres walked)
     info_keys: tuple[str, ...] = ()
-    # an info key that says, as a number, what ended a failed episode, and the words for a number
-    # (Mario: killed_by, a fall, the clock or an enemy; mario_ppo.deaths.cause_name): the evaluation
-    # line counts its failures by cause, and a Deaths plot shows the causes' shares over training
-    cause_key: str | None = None
-    cause_name: Callable[[float], str] = str
-    # config fields that make_env takes in training only (Mario: restart_x, ...): the
-    # trainer's env pool gets them; evaluations, videos and saved models build the env without them
-    train_env_fields: tuple[str, ...] = ()
-    # an info key that marks an episode that did not start where evaluation starts (Mario: restarted):
-    # it trains like any other, but its success is left out of the success share the stop rule reads
-    partial_key: str | None = None
-    partial_start_key: str | None = None  # an info key: where a partial episode started (Mario: start_x)
-    # an attribute of the training env that it builds up over episodes, a dict of name -> array, which
-    # a checkpoint keeps and a resumed run's env pool gets back (Mario: restart_routes, the buttons that
-    # lead to each kept restart point); ignored when the env has no such attribute
-    env_memory: str | None = None
-    # share_env_memory(per_env, config) rewrites the env memory a resumed pool hands out, one dict per
-    # env (Mario: mario_ppo.curriculum.lend_routes, envs whose restart x never stepped back take the
-    # routes of envs whose x did)
-    share_env_memory: Callable[[list[dict], object], list[dict]] | None = None
-    # config fields that name a shipped model (Mario: world, stage -> saved_networks/mario_ppo/1-1);
-    # empty: one model per algorithm, saved_networks/EXPERIMENT/ALGO
-    ship_by: tuple[str, ...] = ()
-    default_model: str = ""  # with ship_by: the folder evaluate/render take without --world/--stage
     score_label: str = "return"  # the y label of the returns plot
     plot_prefix: str = ""  # the plot files' name prefix (empty: the experiment's name)
     video_fps: int = 30
@@ -122,10 +160,14 @@ class Experiment:
     # what meta.json records of the env beyond the experiment's name, so a model folder rebuilds it in
     # a fresh process (a Gymnasium id: its entry point, kwargs, limits; rlcore.gym_experiment)
     env_record: dict = field(default_factory=dict)
+    goal: Goal | None = None  # success is an event an info key marks (Mario: the flag); None: the return
+    curriculum: Curriculum | None = None  # training-only env settings (Mario: restarts); None: none
+    shipped_by: ShippedBy | None = None  # one shipped model per config value (Mario: level); None: per algorithm
 
     def training_env_factory(self, config) -> Callable:
-        """:meth:`env_factory` plus the training-only fields (``train_env_fields``)."""
-        return self.env_factory(config, **{name: getattr(config, name) for name in self.train_env_fields})
+        """:meth:`env_factory` plus the curriculum's training-only fields (``Curriculum.env_fields``)."""
+        fields = self.curriculum.env_fields if self.curriculum else ()
+        return self.env_factory(config, **{name: getattr(config, name) for name in fields})
 
     def env_factory(self, config=None, **kwargs) -> Callable:
         """A picklable no-argument env constructor for ``config`` (env-pool workers call it).

@@ -86,7 +86,7 @@ def export_model(model_dir: str | os.PathLike, fmt: str, out_dir: str | os.PathL
             "converter": converter,
             "parity": {**parity, "observations": int(len(obs)),
                        "seeds": seeds or "given by the caller",
-                       "policy": "sampled from pi as evaluated" if exp.success_key else "greedy",
+                       "policy": "sampled from pi as evaluated" if exp.goal else "greedy",
                        "thresholds": {"max_abs_diff": f"<= {ABS_TOLERANCE:g} + {REL_TOLERANCE:g} x max |Keras output|",
                                       **({} if kind == "sac" else
                                          {"greedy_action_agreement": f">= {GREEDY_AGREEMENT:g}, a different "

@@ -41,7 +41,7 @@ def collect_observations(exp, policy, count: int, episodes: int = 3) -> tuple[np
     if count < 1 or episodes < 1:
         raise UserError("the parity check needs at least one observation from at least one episode")
     env = policy.make_env()
-    sampled = bool(exp.success_key) and getattr(policy, "stochastic", False)
+    sampled = exp.goal is not None and getattr(policy, "stochastic", False)
     seen = []
     try:
         for episode in range(episodes):

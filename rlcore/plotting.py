@@ -21,7 +21,8 @@ def plot_run(run_dir: str | Path, out_dir: str | Path, experiment, about: dict) 
 
     ``about`` says what the run trained (``algo``, ``preset``, ``seed``, ``config``), as a checkpoint's
     state or a ``meta.json`` does. Reads ``metrics.csv`` (one row per episode) and, when present,
-    ``evals.csv``; experiments with a goal (``progress_key``) also get the progress and endings plots.
+    ``evals.csv``; experiments with a goal that measures progress (``Goal.progress_key``) also get the
+    progress and endings plots, and with a cause of failure (``Goal.cause_key``) the Deaths plot.
     """
     missing = [key for key in ABOUT_KEYS if key not in about]
     if missing:
@@ -33,16 +34,18 @@ def plot_run(run_dir: str | Path, out_dir: str | Path, experiment, about: dict) 
     prefix = experiment.plot_prefix or experiment.name
     label = experiment.score_label
     metrics, evals = run_dir / "metrics.csv", run_dir / "evals.csv"
+    goal = experiment.goal
+    partial_key = experiment.curriculum.partial_key if experiment.curriculum else None
     out = [plot_episode_scores(metrics, out_dir / f"{prefix}_Train_{algo}.png", title,
-                               experiment.solved_score, label, experiment.partial_key)]
-    if experiment.progress_key:
+                               experiment.solved_score, label, partial_key)]
+    if goal and goal.progress_key:
         out.append(plot_progress(metrics, out_dir / f"{prefix}_Progress_{algo}.png", title,
-                                 experiment.progress_key, window, experiment.partial_key))
+                                 goal.progress_key, window, partial_key))
         out.append(plot_endings(metrics, out_dir / f"{prefix}_Endings_{algo}.png", title,
-                                experiment.progress_key, experiment.partial_key))
-    if experiment.cause_key and _has_values(metrics, experiment.cause_key):
+                                goal.progress_key, partial_key))
+    if goal and goal.cause_key and _has_values(metrics, goal.cause_key):
         out.append(plot_causes(metrics, out_dir / f"{prefix}_Deaths_{algo}.png", title,
-                               experiment.cause_key, experiment.cause_name))
+                               goal.cause_key, goal.cause_name))
     if evals.exists():
         out.append(plot_evaluations(evals, out_dir / f"{prefix}_Eval_{algo}.png", title,
                                     experiment.solved_score, label))
@@ -51,7 +54,8 @@ def plot_run(run_dir: str | Path, out_dir: str | Path, experiment, about: dict) 
 
 def plot_title(experiment, about: dict) -> str:
     """What trained: experiment, algorithm, the level for one-model-per-level experiments, preset, seed."""
-    level = "-".join(str(about["config"].get(f)) for f in experiment.ship_by)  # Mario: "2-1"
+    fields = experiment.shipped_by.fields if experiment.shipped_by else ()
+    level = "-".join(str(about["config"].get(f)) for f in fields)  # Mario: "2-1"
     return (f"{experiment.name} {about['algo']}{' ' + level if level else ''} "
             f"({about['preset']} preset, seed {about['seed']})")
 

@@ -13,16 +13,16 @@ SAVED_NETWORKS = Path(__file__).resolve().parents[1] / "saved_networks"
 
 def shipped_dir(experiment: str, algo: str, config=None) -> Path:
     """saved_networks/EXPERIMENT/ALGO, or for Mario saved_networks/mario_ppo/WORLD-STAGE (one
-    model per level: the experiment's ``ship_by`` names the config fields; without a config, its
-    ``default_model``)."""
+    model per level: the experiment's ``shipped_by`` names the config fields; without a config, its
+    ``default`` folder)."""
     from rlcore.experiment import get_experiment
 
-    exp = get_experiment(experiment)
-    if not exp.ship_by:
+    shipped_by = get_experiment(experiment).shipped_by
+    if shipped_by is None:
         return SAVED_NETWORKS / experiment / algo
     if config is None:
-        return SAVED_NETWORKS / experiment / exp.default_model
-    return SAVED_NETWORKS / experiment / "-".join(str(getattr(config, f)) for f in exp.ship_by)
+        return SAVED_NETWORKS / experiment / shipped_by.default
+    return SAVED_NETWORKS / experiment / shipped_by.folder(config)
 
 
 
@@ -49,8 +49,9 @@ def run_evaluation(exp, policy, episodes: int, seed_base: int | None) -> tuple[d
     """
     seed_base = exp.eval_seed_base if seed_base is None else seed_base
     seeds = f"{seed_base}..{seed_base + episodes - 1}"
-    success_key, progress_key = exp.success_key, exp.progress_key
-    if success_key:
+    goal = exp.goal
+    if goal:
+        success_key, progress_key = goal.success_key, goal.progress_key
         from rlcore.evaluation import count_causes, evaluate_success, summarize_success
 
         records = evaluate_success(policy.make_env, policy.sample, episodes, seed_base, success_key,
@@ -63,9 +64,9 @@ def run_evaluation(exp, policy, episodes: int, seed_base: int | None) -> tuple[d
         if progress_key:
             line += (f"; {progress_key} mean {summary[f'mean_{progress_key}']:.0f}, "
                      f"max {summary[f'max_{progress_key}']:.0f}")
-        if exp.cause_key and (causes := count_causes(records, exp.cause_key, exp.cause_name)):
+        if goal.cause_key and (causes := count_causes(records, goal.cause_key, goal.cause_name)):
             summary["causes"] = dict(causes)
-            line += f"; {exp.cause_key}: " + ", ".join(f"{name} {count}" for name, count in causes)
+            line += f"; {goal.cause_key}: " + ", ".join(f"{name} {count}" for name, count in causes)
         return summary, line + f" (seeds {seeds}, actions sampled from pi)"
     from rlcore.evaluation import play_greedy
 

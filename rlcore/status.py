@@ -28,7 +28,7 @@ def run_status(run_dir: str | Path, experiment, about: dict, block: int = 200,
     ``blocks`` blocks of ``rollout_block`` rollouts, then the last periodic evaluations."""
     df = read_table(Path(run_dir) / "metrics.csv", "episode", "env_steps", "total_points")
     lines = [headline(about)]
-    full = full_episodes(df, experiment.partial_key)
+    full = full_episodes(df, experiment.curriculum.partial_key if experiment.curriculum else None)
     recent = full.tail(block * blocks)
     if recent.empty:
         return lines + ["no episode from the start logged yet"]
@@ -56,29 +56,31 @@ def headline(about: dict) -> str:
 def block_line(experiment, part: pd.DataFrame, partial: pd.DataFrame | None) -> str:
     """One block of full episodes (and the partial ones logged over the same episodes)."""
     first, last = int(part["episode"].iloc[0]), int(part["episode"].iloc[-1])
+    goal = experiment.goal
+    success_key, progress_key = (goal.success_key, goal.progress_key) if goal else (None, None)
     words = [f"episodes {first:,}-{last:,} (to env step {int(part['env_steps'].iloc[-1]):,}):"]
     if "success" in part and part["success"].notna().any():
         wins = int(part["success"].sum())
-        words.append(f"{experiment.success_key} {wins}/{len(part)} ({wins / len(part):.1%})")
-    if experiment.progress_key and experiment.progress_key in part:
-        words.append(f"mean {experiment.progress_key} {part[experiment.progress_key].mean():,.0f}")
+        words.append(f"{success_key} {wins}/{len(part)} ({wins / len(part):.1%})")
+    if progress_key and progress_key in part:
+        words.append(f"mean {progress_key} {part[progress_key].mean():,.0f}")
     words.append(f"mean return {part['total_points'].mean():.1f}")
     if "episode_steps" in part:  # SAC: how long it stood (a Minitaur fall ends it early)
         words.append(f"mean length {part['episode_steps'].mean():,.0f} steps")
-    if not experiment.success_key:  # Minitaur: x, the metres walked
+    if not success_key:  # Minitaur: x, the metres walked
         words += [f"mean {key} {part[key].mean():,.2f}" for key in experiment.info_keys
                   if key in part and part[key].notna().any()]
     if partial is not None and len(partial):
-        wins = f" ({int(partial['success'].sum())} {experiment.success_key})" if "success" in partial else ""
-        words.append(f"| {experiment.partial_key} {len(partial)}{wins}")
+        wins = f" ({int(partial['success'].sum())} {success_key})" if "success" in partial else ""
+        words.append(f"| {experiment.curriculum.partial_key} {len(partial)}{wins}")
         words += _starts(experiment, partial)
     return " ".join(words)
 
 
 def _starts(experiment, partial: pd.DataFrame) -> list[str]:
-    """Where the partial episodes started (``Experiment.partial_start_key``, Mario's ``start_x``: a
+    """Where the partial episodes started (``Curriculum.partial_start_key``, Mario's ``start_x``: a
     restart x stepping back shows)."""
-    column = experiment.partial_start_key
+    column = experiment.curriculum.partial_start_key if experiment.curriculum else None
     if not column or column not in partial or partial[column].isna().all():
         return []
     low, high = partial[column].min(), partial[column].max()
@@ -103,12 +105,12 @@ def _blocks(rows: pd.DataFrame, block: int) -> list[pd.DataFrame]:
 
 
 def _rollout_line(experiment, part: pd.DataFrame) -> str:
-    key = experiment.partial_key
+    key = experiment.curriculum.partial_key if experiment.curriculum else None
     partial, partial_wins = (part.get(f"{key}_{name}", pd.Series(0, index=part.index)).sum()
                              for name in ("episodes", "successes"))
     from_start, wins = int(part["episodes_ended"].sum() - partial), int(part["successes"].sum())
     words = [f"rollouts {int(part['rollout'].iloc[0])}-{int(part['rollout'].iloc[-1])}:"]
-    label = experiment.success_key or "success"
+    label = (experiment.goal.success_key if experiment.goal else None) or "success"
     words.append(f"{label} {wins}/{from_start}" + (f" ({wins / from_start:.1%})" if from_start else ""))
     if partial:
         words.append(f"| {key} {int(partial_wins)}/{int(partial)} ({partial_wins / partial:.1%})")
@@ -149,19 +151,20 @@ def evaluation_lines(evals_csv: Path, last: int = 3) -> list[str]:
 
 
 def cause_line(experiment, span: pd.DataFrame, most: int = 5) -> str | None:
-    """The commonest causes of failure (``Experiment.cause_key``) in ``span``, as shares. The span
+    """The commonest causes of failure (``Goal.cause_key``) in ``span``, as shares. The span
     holds every episode since the first of the blocks, restarted ones included, and says so."""
-    key = experiment.cause_key
+    goal = experiment.goal
+    key = goal.cause_key if goal else None
     if not key or key not in span or span[key].isna().all():
         return None
-    causes = count_causes(span[[key]].to_dict("records"), key, experiment.cause_name)
+    causes = count_causes(span[[key]].to_dict("records"), key, goal.cause_name)
     total = sum(n for _, n in causes)
     shares = ", ".join(f"{name} {n / total:.0%}" for name, n in causes[:most])
     return f"{key} over all episodes since {int(span['episode'].iloc[0]):,} ({total:,} failures): {shares}"
 
 
 def _partial_between(df: pd.DataFrame, experiment, part: pd.DataFrame) -> pd.DataFrame | None:
-    key = experiment.partial_key
+    key = experiment.curriculum.partial_key if experiment.curriculum else None
     if not key or key not in df:
         return None
     between = df["episode"].between(part["episode"].iloc[0], part["episode"].iloc[-1])

@@ -137,7 +137,7 @@ class EnvPool:
         self.envs.closed = True  # Gymnasium's __del__ would try to close it again
 
     def memory(self, name: str) -> list[dict] | None:
-        """Each env's value of the attribute ``name`` (``Experiment.env_memory``); None when the envs
+        """Each env's value of the attribute ``name`` (``Curriculum.memory``); None when the envs
         have no such attribute (Mario without restarts)."""
         if self.closed:
             raise RuntimeError("the env pool is closed: read its envs' memory before closing it")

@@ -119,7 +119,8 @@ def record_video(experiment, policy, path: str | Path, fps: int = 30, episodes: 
     env = make_env(render_mode="rgb_array")
     act = act or (lambda obs, rng: policy(obs))
     returns, lengths, successes = [], [], []
-    success_key = getattr(experiment, "success_key", None)
+    goal = getattr(experiment, "goal", None)
+    success_key = goal.success_key if goal else None
     with atomic_path(path) as tmp:
         writer = _Gif(tmp, fps, gif_every(fps)) if gif else _Mp4(tmp, fps)
         try:

@@ -56,7 +56,7 @@ def test_every_shipped_model_has_a_bar_and_every_bar_a_model():
     for name in experiment_names():
         exp = get_experiment(name)
         for folder in exp.bars:
-            assert folder in exp.algos or exp.ship_by, (name, folder)
+            assert folder in exp.algos or exp.shipped_by, (name, folder)
             if folder in exp.algos:
                 assert (name, folder) in shipped, (name, folder)
     assert len(MODELS) == 17
@@ -73,12 +73,12 @@ def still_plays(exp, meta: dict, policy, folder: str) -> str:
 
 def _replay_exactly(exp, meta, policy) -> None:
     recorded = meta["evaluation"]["per_episode"]
-    if exp.success_key:
-        records = evaluate_success(policy.make_env, policy.sample, 3, exp.eval_seed_base, exp.success_key,
-                                   exp.progress_key, progress=False, stop_at_success=True)
+    if goal := exp.goal:
+        records = evaluate_success(policy.make_env, policy.sample, 3, exp.eval_seed_base, goal.success_key,
+                                   goal.progress_key, progress=False, stop_at_success=True)
         for got, want in zip(records, recorded):
             assert (got["seed"], got["success"], got["length"]) == (want["seed"], want["success"], want["length"])
-            assert got[exp.progress_key] == want[exp.progress_key]
+            assert got[goal.progress_key] == want[goal.progress_key]
         return
     n = REPLAYED_EPISODES.get(exp.name, 5)
     returns = evaluate(exp, policy, episodes=n, progress=False, make_env=policy.make_env)
@@ -88,10 +88,10 @@ def _replay_exactly(exp, meta, policy) -> None:
 
 def _clears_bar_live(exp, meta, policy, folder: str) -> None:
     bar = exp.bar(folder)
-    if exp.success_key:
+    if goal := exp.goal:
         records = evaluate_success(policy.make_env, policy.sample, SUCCESS_TRIES, exp.eval_seed_base,
-                                   exp.success_key, exp.progress_key, progress=False, stop_at_success=True)
-        assert records[-1]["success"], f"{exp.name} {folder}: no {exp.success_key} in {len(records)} episodes"
+                                   goal.success_key, goal.progress_key, progress=False, stop_at_success=True)
+        assert records[-1]["success"], f"{exp.name} {folder}: no {goal.success_key} in {len(records)} episodes"
         return
     n = LIVE_EPISODES[exp.name]
     returns = evaluate(exp, policy, episodes=n, progress=False, make_env=policy.make_env)
@@ -117,7 +117,7 @@ def test_shipped_model_meets_its_bar(experiment, algo, folder):
     assert bar.met_by(evaluation), (bar, {k: v for k, v in evaluation.items() if k != "per_episode"})
     recorded = evaluation["per_episode"]
     assert len(recorded) == exp.eval_episodes
-    if exp.success_key:
+    if exp.goal:
         assert np.mean([r["success"] for r in recorded]) == pytest.approx(evaluation["success_share"])
     else:
         assert np.mean([r["return"] for r in recorded]) == pytest.approx(evaluation["mean"], abs=0.01)

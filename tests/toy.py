@@ -9,7 +9,7 @@ import gymnasium as gym
 import numpy as np
 
 from rlcore.configs import A2CConfig, DQNConfig, PPOConfig, SACConfig
-from rlcore.experiment import AlgoSpec, Experiment
+from rlcore.experiment import AlgoSpec, Experiment, Goal
 from rlcore.trainers import a2c, dqn, ppo, sac
 
 TRAINERS = {"dqn": dqn, "a2c": a2c, "ppo": ppo, "sac": sac}  # each module's train(spec) runs one run
@@ -117,7 +117,7 @@ PPO = PPOConfig(num_envs=2, vec="inline", n_steps=16, epochs=4, minibatch=16, lr
 IMAGE_EXPERIMENT = Experiment(
     name="toy_image", description="sign bandit as pictures", make_env=make_image_env, solved_score=None,
     algos={"ppo": AlgoSpec("ppo", "ppo", "PPO", {"default": PPO})},
-    eval_seed_base=10_000, success_key="won", progress_key="score", eval_episodes=10)
+    eval_seed_base=10_000, goal=Goal("won", progress_key="score"), eval_episodes=10)
 
 
 class ReachEnv(gym.Env):

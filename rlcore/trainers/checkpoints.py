@@ -60,7 +60,7 @@ def save(session: TrainingSession, agent, rng: np.random.Generator, memory: Repl
 
 
 def env_memory(envs, name: str | None) -> dict:
-    """What each env of the pool built up (``Experiment.env_memory``), as checkpoint arrays
+    """What each env of the pool built up (``Curriculum.memory``), as checkpoint arrays
     ``env/<i>/<key>``; empty when the experiment declares none or the envs do not have it."""
     kept = envs.memory(name) if name else None
     return {f"env/{i}/{key}": np.asarray(value) for i, values in enumerate(kept or [])
@@ -69,7 +69,7 @@ def env_memory(envs, name: str | None) -> dict:
 
 def give_env_memory(envs, name: str | None, arrays: dict, share=None, config=None) -> None:
     """Hand each env of a resumed run what it had built up (:func:`env_memory`'s arrays), first
-    rewritten by ``share(per_env, config)`` (``Experiment.share_env_memory``) when given."""
+    rewritten by ``share(per_env, config)`` (``Curriculum.share_memory``) when given."""
     if not name:
         return
     per_env = [{} for _ in range(envs.num_envs)]

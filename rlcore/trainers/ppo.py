@@ -59,10 +59,12 @@ def train(spec: RunSpec) -> Path:
         tqdm.write(note)
     rng = np.random.default_rng(spec.seed)
 
+    curriculum = exp.curriculum
+    memory = curriculum.memory if curriculum else None  # what the envs build up (Mario: restart routes)
     state, arrays = checkpoints.restore(spec, agent, rng)
     if state is not None:
         parent = state.get("init_from")
-        checkpoints.give_env_memory(envs, exp.env_memory, arrays, exp.share_env_memory, cfg)  # Mario: restarts
+        checkpoints.give_env_memory(envs, memory, arrays, curriculum.share_memory if curriculum else None, cfg)
     else:
         parent = init_weights(agent, cfg.init_from, exp.name, spec.algo) if cfg.init_from else None
     session = TrainingSession(spec, state, progress_unit="step")
@@ -123,9 +125,9 @@ def train(spec: RunSpec) -> Path:
                 agent.set_learning_rate(lr.rate())
                 tqdm.write(halved)
             if rollouts % cfg.checkpoint_rollouts == 0:
-                env_kept = checkpoints.env_memory(envs, exp.env_memory)
+                env_kept = checkpoints.env_memory(envs, memory)
                 checkpoint()
-        env_kept = checkpoints.env_memory(envs, exp.env_memory)  # the last checkpoint is written after the pool
+        env_kept = checkpoints.env_memory(envs, memory)  # the last checkpoint is written after the pool
         # closes (session.conclude), so its reading is taken here, while the pool still answers
     # the model's story starts with the run whose weights it started from
     return session.conclude(checkpoint, agent.save, **({"init_from": parent} if parent else {}))

@@ -140,7 +140,7 @@ def test_a_resumed_pool_lends_the_routes_of_envs_that_stepped_back_to_envs_that_
     assert lend_routes(level, run) is level  # none did: nothing to lend
     plain = [{"1": np.zeros(3, np.uint8)}, {}]
     assert lend_routes(plain, run) is plain  # no stepping x
-    assert EXPERIMENT.share_env_memory is lend_routes
+    assert EXPERIMENT.curriculum.share_memory is lend_routes
 
 
 def test_give_env_memory_hands_out_what_the_experiment_shares():

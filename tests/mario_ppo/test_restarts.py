@@ -155,10 +155,10 @@ def test_a_pool_of_processes_hands_the_routes_out_and_back():
         envs.reset(seed=[0, 1])
         for _ in range(60):  # 240 frames of `right`: both envs pass x 160 (and die nowhere)
             envs.step(np.full(2, RIGHT))
-        arrays = checkpoints.env_memory(envs, EXPERIMENT.env_memory)
+        arrays = checkpoints.env_memory(envs, EXPERIMENT.curriculum.memory)
     assert {"env/0/1", "env/0/2", "env/1/1", "env/1/2"} <= set(arrays)
     with EnvPool([factory] * 2, mode="processes") as resumed:
-        checkpoints.give_env_memory(resumed, EXPERIMENT.env_memory, arrays)
+        checkpoints.give_env_memory(resumed, EXPERIMENT.curriculum.memory, arrays)
         _, infos = resumed.reset(seed=[5, 6])
         assert infos["restarted"].all() and (infos["x_pos"] >= EVERY).all()
 

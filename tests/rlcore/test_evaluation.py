@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from rlcore.evaluation import evaluate, evaluate_success, play_greedy
-from rlcore.experiment import Experiment
+from rlcore.experiment import Experiment, Goal
 from rlcore.shipping import run_evaluation
 
 LIMIT = 6
@@ -88,8 +88,8 @@ def test_a_success_evaluation_counts_its_failures_by_cause():
             return ALWAYS_ZERO(obs)
 
     exp = Experiment(name="cause", description="", make_env=lambda **_: FallWithCause(), algos={},
-                     solved_score=None, success_key="won", info_keys=("cause",), cause_key="cause",
-                     cause_name=lambda code: ["rock", "hole", "bird"][int(code)])
+                     solved_score=None, info_keys=("cause",),
+                     goal=Goal("won", cause_key="cause", cause_name=lambda code: ["rock", "hole", "bird"][int(code)]))
     # seeds 10-17: the odd ones win; 10, 12, 14, 16 fall after 1, 3, 5, 2 steps: causes 1, 0, 2, 2
     summary, line = run_evaluation(exp, Policy(), episodes=8, seed_base=10)
     assert summary["success_share"] == 0.5 and summary["causes"] == {"bird": 2, "hole": 1, "rock": 1}

@@ -9,6 +9,7 @@ import pandas as pd
 import pytest
 
 from rlcore.configs import PPOConfig
+from rlcore.experiment import Curriculum
 from rlcore.trainers import ppo as ppo_trainer
 from rlcore.trainers.episodes import EpisodeBook
 from tests import toy
@@ -44,7 +45,7 @@ def test_partial_episodes_train_and_are_logged_but_not_counted_toward_the_succes
     spec.experiment = dataclasses.replace(
         spec.experiment, make_env=lambda render_mode=None, max_episode_steps=10, partial_every=0:
         PartlyRestartedEnv(max_episode_steps, render_mode, partial_every),
-        train_env_fields=("partial_every",), partial_key="partial")
+        curriculum=Curriculum(env_fields=("partial_every",), partial_key="partial"))
     meta_dir = ppo_trainer.train(spec)
     rows = pd.read_csv(spec.run_dir / "metrics.csv")
     # half the episodes were partial (so the trainer's envs got the training-only field) and won
@@ -114,7 +115,7 @@ def test_a_checkpoint_keeps_what_each_env_built_up_and_a_resume_hands_it_back(tm
     spec = toy.spec("ppo", tmp_path, max_episodes=12, stop_success_share=0.0)
     spec.experiment = dataclasses.replace(
         spec.experiment, make_env=lambda render_mode=None, max_episode_steps=10:
-        RememberingEnv(max_episode_steps, render_mode), env_memory="memory")
+        RememberingEnv(max_episode_steps, render_mode), curriculum=Curriculum(memory="memory"))
     RememberingEnv.given.clear()
     ppo_trainer.train(spec)
     with np.load(spec.run_dir / CHECKPOINT_FILE) as saved:
@@ -146,7 +147,7 @@ def test_every_checkpoint_keeps_the_env_memory_as_it_stood_then(tmp_path, monkey
     spec = toy.spec("ppo", tmp_path, max_episodes=12, stop_success_share=0.0, checkpoint_rollouts=every)
     spec.experiment = dataclasses.replace(
         spec.experiment, make_env=lambda render_mode=None, max_episode_steps=10:
-        RememberingEnv(max_episode_steps, render_mode), env_memory="memory")
+        RememberingEnv(max_episode_steps, render_mode), curriculum=Curriculum(memory="memory"))
     seen, save = [], checkpoints.save
 
     def spy(session, *args, env_arrays=None, **kwargs):
