@@ -76,6 +76,16 @@ class MarioPPOConfig(PPOConfig):
                 "get past --restart-goal-x before its x steps back",
         "allowed": Allowed(low=0, high=1, low_open=True)})
 
+    # `train mario_ppo ppo --help` lists these apart from PPO's own hyperparameters
+    HELP_GROUPS = {
+        "the level and its env (each defines the run: a resume cannot change it)":
+            ("world", "stage", "actions", "frames", "score_reward", "stall_steps", "stall_outcome", "dead_ends"),
+        "restarts, a training curriculum (research knobs, off by default; evaluation always starts at the "
+        "level's start)":
+            ("restart_x", "restart_every", "restart_share", "restart_weights", "restart_keep",
+             "restart_back_step", "restart_goal_x", "restart_back_share"),
+    }
+
     def __post_init__(self):
         super().__post_init__()
         require(not (self.restart_x and self.restart_every),

@@ -42,15 +42,23 @@ def field_types(cls) -> dict[str, typing.Callable[[str], object]]:
 
 
 def add_arguments(parser: argparse.ArgumentParser, cfg) -> None:
-    """Add one ``--name`` option per field of dataclass instance ``cfg`` (default: keep the preset)."""
-    group = parser.add_argument_group(f"hyperparameters ({type(cfg).__name__}; defaults shown are the preset's)")
+    """Add one ``--name`` option per field of dataclass instance ``cfg`` (default: keep the preset).
+
+    A config class may set ``HELP_GROUPS`` (title -> field names) to list some fields apart, below the
+    others: research knobs that are off by default read apart from the algorithm's hyperparameters."""
+    main = parser.add_argument_group(f"hyperparameters ({type(cfg).__name__}; defaults shown are the preset's)")
+    groups = {}  # field name -> its argument group, for the fields listed apart
+    for title, names in getattr(type(cfg), "HELP_GROUPS", {}).items():
+        group = parser.add_argument_group(title)
+        groups.update(dict.fromkeys(names, group))
     types = field_types(type(cfg))
     for f in dataclasses.fields(cfg):
         value = getattr(cfg, f.name)
         shown = (",".join(map(str, value)) or "empty") if isinstance(value, tuple) else value
-        group.add_argument(f"--{f.name.replace('_', '-')}", dest=f"hp_{f.name}", default=None,
-                           type=types[f.name], metavar=type(value).__name__.upper(),
-                           help=f"{f.metadata.get('help', '')} (default: {shown}{_allowed_text(f)})")
+        groups.get(f.name, main).add_argument(
+            f"--{f.name.replace('_', '-')}", dest=f"hp_{f.name}", default=None, type=types[f.name],
+            metavar=type(value).__name__.upper(),
+            help=f"{f.metadata.get('help', '')} (default: {shown}{_allowed_text(f)})")
 
 
 def _allowed_text(f: dataclasses.Field) -> str:

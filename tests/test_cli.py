@@ -284,3 +284,13 @@ def test_the_installed_script_is_deeprl_and_says_its_version():
     assert done.returncode == 0 and done.stdout.strip() == f"deeprl {dist.version}"
     helped = subprocess.run([str(script), "train", "--help"], capture_output=True, text=True, timeout=60)
     assert helped.stdout.startswith("usage: deeprl train") and "mario_ppo: ppo" in helped.stdout
+
+
+def test_marios_help_lists_its_level_and_its_research_knobs_apart(capsys):
+    code, out, _ = run(capsys, "train", "mario_ppo", "ppo", "--help")
+    assert code == 0
+    main_part, _, rest = out.partition("\nhyperparameters (")[2].partition("\nthe level and its env")
+    level_part, _, knobs = rest.partition("\nrestarts, a training curriculum")
+    assert "--lr FLOAT" in main_part and "--restart-x" not in main_part and "--world" not in main_part
+    assert "--world INT" in level_part and "--frames" in level_part
+    assert all(f"--restart-{name}" in knobs for name in ("x", "every", "share", "back-step", "goal-x"))
