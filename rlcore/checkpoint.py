@@ -12,11 +12,16 @@ import numpy as np
 from rlcore.atomic import atomic_path
 from rlcore.errors import UserError
 
+# the format of a checkpoint's state: 1 = unversioned (before 2026-11-27), 2 = versioned, with
+# ``command_starts``. A reader refuses a format newer than its own rather than misread it.
+CHECKPOINT_VERSION = 2
+
 
 def save_checkpoint(path: str | Path, models: dict, optimizers: dict, state: dict,
                     arrays: dict[str, np.ndarray] | None = None) -> Path:
     """Write Keras ``models`` and ``optimizers`` (by name), a JSON-able ``state`` and extra ``arrays``."""
     # UTF-8 bytes: a numpy string array would hold 4 bytes per character (Mario's episode list: MBs)
+    state = {**state, "checkpoint_version": CHECKPOINT_VERSION}
     payload = {"state_json": np.frombuffer(json.dumps(state, default=str).encode(), np.uint8)}
     for name, model in models.items():
         for i, w in enumerate(model.get_weights()):
@@ -42,9 +47,14 @@ def read_checkpoint_state(path: str | Path) -> dict:
         with np.load(path) as data:
             text = data["state_json"]
             # checkpoints written before 2026-11-24 hold the JSON as a numpy string
-            return json.loads(text.tobytes().decode() if text.dtype == np.uint8 else str(text))
+            state = json.loads(text.tobytes().decode() if text.dtype == np.uint8 else str(text))
     except Exception as exc:
         raise UserError(f"checkpoint {path} is damaged or not one of ours ({type(exc).__name__})")
+    version = state.get("checkpoint_version", 1)
+    if not isinstance(version, int) or version > CHECKPOINT_VERSION:
+        raise UserError(f"checkpoint {path} has format {version}, newer than this package reads "
+                        f"({CHECKPOINT_VERSION}): update the package (pip install -e . in a newer checkout)")
+    return state
 
 
 def load_checkpoint(path: str | Path, models: dict, optimizers: dict) -> tuple[dict, dict[str, np.ndarray]]:

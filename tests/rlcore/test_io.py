@@ -68,7 +68,7 @@ def test_checkpoint_round_trip_and_mismatch(tmp_path):
                            {"extra": np.arange(3)})
     fresh = DQNAgent(4, 2, DQNConfig(hidden=(8,)))
     state, arrays = load_checkpoint(path, fresh.models(), fresh.optimizers())
-    assert state == {"steps": 7} and arrays["extra"].tolist() == [0, 1, 2]
+    assert state["steps"] == 7 and arrays["extra"].tolist() == [0, 1, 2]
     for a, b in zip(agent.optimizer.variables, fresh.optimizer.variables):
         np.testing.assert_array_equal(np.asarray(a), np.asarray(b))
     # the same next update from both: weights and Adam moments were restored
@@ -163,14 +163,24 @@ def test_tracker_drops_rows_logged_after_a_checkpoint(tmp_path):
 
 
 def test_the_checkpoint_state_is_utf8_and_older_checkpoints_still_read(tmp_path):
-    from rlcore.checkpoint import read_checkpoint_state
+    from rlcore.checkpoint import CHECKPOINT_VERSION, read_checkpoint_state
 
     state = {"returns": [1.5] * 1000, "name": "Mario 2-1 – ünïcode"}
     path = save_checkpoint(tmp_path / "new.npz", {}, {}, state)
     with np.load(path) as data:
         assert data["state_json"].dtype == np.uint8  # 1 byte per character, not a numpy string's 4
         assert data["state_json"].nbytes < 1.1 * len(json.dumps(state, ensure_ascii=False).encode())
-    assert read_checkpoint_state(path) == state
-    old = tmp_path / "old.npz"  # as written before: the JSON as a numpy string array
+    assert read_checkpoint_state(path) == {**state, "checkpoint_version": CHECKPOINT_VERSION}
+    old = tmp_path / "old.npz"  # as written before: the JSON as a numpy string array, no version
     np.savez(old, state_json=np.array(json.dumps(state)))
     assert read_checkpoint_state(old) == state
+
+
+def test_a_checkpoint_from_a_newer_format_is_refused_not_misread(tmp_path):
+    from rlcore.checkpoint import CHECKPOINT_VERSION, read_checkpoint_state
+
+    newer = tmp_path / "newer.npz"
+    state = {"checkpoint_version": CHECKPOINT_VERSION + 1}
+    np.savez(newer, state_json=np.frombuffer(json.dumps(state).encode(), np.uint8))
+    with pytest.raises(UserError, match=f"format {CHECKPOINT_VERSION + 1}, newer than this package reads"):
+        read_checkpoint_state(newer)
