@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from rlcore.agents.protocol import Agent
 from rlcore.atomic import atomic_path
 from rlcore.checkpoint import load_checkpoint, save_checkpoint
 from rlcore.replay import ReplayMemory
@@ -25,7 +26,7 @@ from rlcore.trainers.spec import CHECKPOINT_FILE, RunSpec, check_resumable
 REPLAY_FILE = "replay.npz"
 
 
-def restore(spec: RunSpec, agent, rng: np.random.Generator,
+def restore(spec: RunSpec, agent: Agent, rng: np.random.Generator,
             memory: ReplayMemory | None = None) -> tuple[dict | None, dict]:
     """For a resumed run: put back the agent's weights and optimizers, the RNG and the replay memory;
     return ``(state, arrays)``. For a new run: ``(None, {})``."""
@@ -40,7 +41,7 @@ def restore(spec: RunSpec, agent, rng: np.random.Generator,
     return state, arrays
 
 
-def save(session: TrainingSession, agent, rng: np.random.Generator, memory: ReplayMemory | None = None,
+def save(session: TrainingSession, agent: Agent, rng: np.random.Generator, memory: ReplayMemory | None = None,
          env_arrays: dict | None = None, **counters) -> None:
     """Write the checkpoint (and the replay memory first, stamped with the same env step count);
     ``env_arrays``: what the envs kept (:func:`env_memory`); ``counters``: the trainer's own

@@ -184,3 +184,17 @@ def test_a_checkpoint_from_a_newer_format_is_refused_not_misread(tmp_path):
     np.savez(newer, state_json=np.frombuffer(json.dumps(state).encode(), np.uint8))
     with pytest.raises(UserError, match=f"format {CHECKPOINT_VERSION + 1}, newer than this package reads"):
         read_checkpoint_state(newer)
+
+
+def test_every_agent_offers_what_the_shared_plumbing_calls():
+    from rlcore.agents.a2c import A2CAgent
+    from rlcore.agents.dqn import DQNAgent
+    from rlcore.agents.ppo import PPOAgent
+    from rlcore.agents.protocol import Agent
+    from rlcore.agents.sac import SACAgent
+
+    for agent_class in (DQNAgent, A2CAgent, PPOAgent, SACAgent):
+        missing = [name for name in ("models", "optimizers", "sync_policy_weights", "save")
+                   if not callable(getattr(agent_class, name, None))]
+        assert not missing, (agent_class.__name__, missing)
+        assert issubclass(agent_class, Agent)
