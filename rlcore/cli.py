@@ -271,6 +271,8 @@ def cmd_sweep(args) -> int:
     for row in sorted(rows, key=lambda r: r["trial"]):
         if row.get("error"):
             status = f"failed: {row['error']}"
+        elif row.get("not_started"):
+            status = "not started (--resume starts it)"
         elif row.get("interrupted"):
             status = "stopped at a checkpoint (--resume continues it)"
         else:

@@ -154,6 +154,8 @@ def run_trial(trial: dict, sweep: dict, modules: dict, report) -> dict:
     meta_path = run_dir / "model" / "meta.json"
     if meta_path.is_file():  # finished before: not run again
         return final_metrics(json.loads(meta_path.read_text()), skipped=True)
+    if (Path(sweep.folder) / STOP_FILE).exists():  # the sweep is stopping: a trial not begun stays so
+        return {"interrupted": 1, "not_started": 1}
     from rlcore.run_lock import hold_run_folder
 
     log_trial(sweep, trial, "started")
@@ -278,6 +280,7 @@ def run_sweep(sweep: Sweep, address: str | None = None, num_cpus: int | None = N
     (folder / STOP_FILE).unlink(missing_ok=True)
     os.environ["TUNE_DISABLE_SIGINT_HANDLER"] = "1"  # our handler: stop trials at a checkpoint
     os.environ.setdefault("RAY_AIR_NEW_OUTPUT", "0")
+    os.environ.setdefault("TUNE_WARN_THRESHOLD_S", "600")  # no "may be a performance bottleneck" lines
     started = start_ray(address, num_cpus)
     from ray import tune
 

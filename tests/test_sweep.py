@@ -133,6 +133,22 @@ def test_ctrl_c_stops_at_a_checkpoint_and_resume_skips_finished_trials(local_ray
     assert (trial / "model" / "meta.json").stat().st_mtime == finished_mtime
 
 
+def test_a_stopped_sweep_does_not_begin_the_trials_still_waiting(local_ray, tmp_path):
+    """One trial at a time, stopped during the first: the second is not begun (no run folder, no
+    step-0 checkpoint), and a resume starts it."""
+    sweep = Sweep("toy", "dqn", "queue", str(tmp_path / "queue"), [0, 1], {}, None,
+                  {**BUDGET, "max_episodes": 4000, "checkpoint_every": 5}, 1.0, 1, 5)
+    first = tmp_path / "queue" / "seed=0"
+
+    def stop():
+        _wait_for(first / "checkpoint.npz")
+        (tmp_path / "queue" / STOP_FILE).touch()  # as the driver's signal handler does
+    threading.Thread(target=stop, daemon=True).start()
+    rows = {row["trial"]: row for row in run_sweep(sweep)}
+    assert rows["seed=0"].get("interrupted") == 1 and rows["seed=1"].get("not_started") == 1, rows
+    assert not (tmp_path / "queue" / "seed=1").exists()
+
+
 def test_a_trial_that_fails_with_a_user_error_is_reported_once_not_retried(local_ray, tmp_path):
     """Its run folder is written by another process (this one): the trial is refused, and a retry
     would be refused the same way, so there is none."""
