@@ -235,9 +235,7 @@ def start_ray(address: str | None, num_cpus: int | None) -> bool:
     """Start local Ray on 127.0.0.1 (or join ``address``). Returns whether this call started it."""
     os.environ.setdefault("RAY_USAGE_STATS_ENABLED", "0")  # never phone home
     if not address:
-        # Seen with Ray 2.60: without this variable its services also listen on the machine's network
-        # address; with it every socket stays on loopback. Local Ray only, never when joining a cluster.
-        os.environ["RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER"] = "0"
+        loopback_only()
     import ray
 
     if ray.is_initialized():
@@ -253,6 +251,19 @@ def start_ray(address: str | None, num_cpus: int | None) -> bool:
         ray.init(num_cpus=num_cpus or os.cpu_count(), include_dashboard=False, _node_ip_address="127.0.0.1",
                  runtime_env=runtime_env, log_to_driver=False, configure_logging=False)
     return True
+
+
+def loopback_only() -> None:
+    """Keep every socket of a local Ray on 127.0.0.1 (never call it when joining a cluster).
+
+    Seen with Ray 2.60: without ``RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER=0`` its services also listen on
+    the machine's network address. Ray's services read the variable when they start (they inherit it);
+    this process read it when it first imported Ray, which may have happened already (the sweep
+    command's check for its extra imports ``ray.tune``), so the flag it derived is set here as well."""
+    os.environ["RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER"] = "0"
+    constants = sys.modules.get("ray._private.ray_constants")
+    if constants is not None:
+        constants.ENABLE_RAY_CLUSTER = False
 
 
 @contextlib.contextmanager

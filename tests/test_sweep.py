@@ -23,6 +23,9 @@ ROOT = Path(__file__).resolve().parents[1]
 BUDGET = {"max_episodes": 40, "stop_score": 99.0, "checkpoint_every": 10}
 
 
+LOOPBACK = ("127.0.0.1", "[::ffff:127.0.0.1]", "[::1]")
+
+
 def _ray_pids() -> set[str]:
     out = subprocess.run(["pgrep", "-f", "raylet|gcs_server|ray::"], capture_output=True, text=True).stdout
     return set(out.split())
@@ -65,8 +68,7 @@ def _wait_for(path, timeout=120):
 def test_local_ray_listens_on_loopback_only(local_ray):
     sockets = _ray_sockets()
     assert sockets, "no Ray service found listening"
-    loopback = ("127.0.0.1", "[::ffff:127.0.0.1]", "[::1]")
-    outside = [s for s in sockets if s.split()[3].rsplit(":", 1)[0] not in loopback]
+    outside = [s for s in sockets if s.split()[3].rsplit(":", 1)[0] not in LOOPBACK]
     assert not outside, outside
 
 
@@ -324,9 +326,15 @@ def test_sigterm_to_the_sweeps_process_group_stops_its_trials_at_a_checkpoint(tm
                             cwd=ROOT, start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True)
     _wait_for(folder / "seed=0" / "checkpoint.npz", timeout=240)
+    # the command imports ray.tune (its check for the sweep extra) before it starts Ray: still loopback only
+    group = set(subprocess.run(["pgrep", "-g", str(proc.pid)], capture_output=True, text=True).stdout.split())
+    sockets = [s for s in subprocess.run(["ss", "-tnlpH"], capture_output=True, text=True).stdout.splitlines()
+               if any(f"pid={pid}," in s for pid in group)]
+    outside = [s for s in sockets if s.split()[3].rsplit(":", 1)[0] not in LOOPBACK]
     os.killpg(proc.pid, signal.SIGTERM)
     out, err = proc.communicate(timeout=180)
     assert proc.returncode == 130, err[-2000:]
+    assert sockets and not outside, outside or "no socket of the sweep's Ray found"
     assert "seed=0: stopped at a checkpoint" in out, out
     assert group_is_gone(proc.pid, timeout=30)
     log = (folder / "trials.log").read_text()
