@@ -87,6 +87,19 @@ def test_a_two_seed_sweep_runs_to_the_end_and_its_report_matches_the_run_folders
     assert [r["env_steps"] for r in load_runs(tmp_path / "two")] == [m["env_steps"] for m in metas]
 
 
+def test_a_sweep_and_its_report_work_on_a_gymnasium_id(local_ray, tmp_path):
+    """Not one of the package's experiments: the trials build the env from its Gymnasium id."""
+    sweep = Sweep("CartPole-v1", "dqn", "gym", str(tmp_path / "gym"), [0, 1], {}, None,
+                  {"max_episodes": 5, "checkpoint_every": 5}, 1.0, 0, 2)
+    rows = run_sweep(sweep)
+    assert all(r["error"] is None and r["finished"] == 1 for r in rows), rows
+    metas = [json.loads((tmp_path / "gym" / t / "model" / "meta.json").read_text()) for t in ("seed=0", "seed=1")]
+    assert [m["experiment"] for m in metas] == ["CartPole-v1"] * 2 and [m["seed"] for m in metas] == [0, 1]
+    result = summarize([tmp_path / "gym"], reps=200)
+    mean = result["sweeps"][0]["aggregates"]["mean"][0]
+    assert mean == pytest.approx(np.mean([m["evaluation"]["mean"] for m in metas]))
+
+
 def test_a_killed_trial_resumes_from_its_checkpoint(local_ray, tmp_path):
     sweep = _sweep(tmp_path, "kill", seeds=(0,), max_episodes=400, checkpoint_every=5)
     trial = tmp_path / "kill" / "seed=0"
