@@ -221,11 +221,10 @@ def model_folder(model: str | os.PathLike[str] | tuple[str, str]) -> Path:
             exp.algo(which)  # an unknown algorithm: one line naming the known ones
             folder = shipping.shipped_dir(name, which)
         else:
-            folder = shipping.SAVED_NETWORKS / name / which
+            folder = shipping.models_root() / name / which
         if not (folder / "meta.json").is_file():
-            shipped = sorted(p.parent.name for p in (shipping.SAVED_NETWORKS / name).glob("*/meta.json"))
-            raise UserError(f"no shipped model {name} {which} in {shipping.SAVED_NETWORKS}; shipped: "
-                            f"{', '.join(shipped) or 'none'} (or give a model folder)")
+            shipped = sorted(p.parent.name for p in folder.parent.glob("*/meta.json"))
+            raise shipping.no_shipped_model(f"{name} {which}", folder, shipped)
         return folder
     folder = Path(model)
     finished = folder / "model"

@@ -35,7 +35,7 @@ def cmd_list(args) -> int:
         print(f"{name}: {exp.description}")
         for algo, spec in exp.algos.items():
             folders = ([shipping.shipped_dir(name, algo)] if exp.shipped_by is None
-                       else sorted((shipping.SAVED_NETWORKS / name).glob("*-*")))
+                       else sorted((shipping.models_root() / name).glob("*-*")))
             shipped = [shipping.shipped_summary(f) for f in folders if (f / "meta.json").is_file()]
             print(f"  {algo:<14} {spec.description:<24} presets: {', '.join(spec.presets):<25} "
                   f"{'; '.join(shipped) or 'no shipped model'}")
@@ -102,7 +102,11 @@ def _model_dir(args) -> Path:
         finished = folder / "model"  # a finished run's folder: its model
         return finished if (finished / "meta.json").is_file() and not (folder / "meta.json").is_file() else folder
     if level == (None, None):
-        return shipping.shipped_dir(args.experiment, args.algo)
+        folder = shipping.shipped_dir(args.experiment, args.algo)
+        if not (folder / "meta.json").is_file():
+            shipped = sorted(p.parent.name for p in folder.parent.glob("*/meta.json"))
+            raise shipping.no_shipped_model(f"{args.experiment} {args.algo}", folder, shipped)
+        return folder
     if exp.shipped_by is None:
         raise UserError(f"--world/--stage choose a Mario level; {exp.name} ships one model per algorithm")
     if args.model:
@@ -113,8 +117,7 @@ def _model_dir(args) -> Path:
                                                                        stage=args.stage or 1))
     if not (folder / "meta.json").is_file():
         shipped = sorted(p.parent.name for p in folder.parent.glob("*-*/meta.json"))
-        raise UserError(f"no shipped model for level {folder.name}; shipped levels: {', '.join(shipped) or 'none'}"
-                        f" (or pass --model RUN_DIR/model)")
+        raise shipping.no_shipped_model(f"for level {folder.name}", folder, shipped)
     return folder
 
 

@@ -2,27 +2,56 @@
 evaluation a model folder records in its meta.json. TensorFlow is imported only to evaluate."""
 from __future__ import annotations
 
+import os
 import shutil
 from pathlib import Path
 
 import numpy as np
 
-#: the repository's saved_networks/, wherever the command is run from
+from rlcore.errors import UserError
+
+#: the saved_networks/ of the checkout this package runs from (``python main.py`` or an editable install)
 SAVED_NETWORKS = Path(__file__).resolve().parents[1] / "saved_networks"
+#: where to find the shipped models when the package is installed apart from its checkout
+MODELS_ENV = "DEEPRL_MODELS"
+
+
+def models_root() -> Path:
+    """The folder shipped models are read from (and ``--publish`` writes to): ``$DEEPRL_MODELS`` if set;
+    else the checkout's saved_networks/; else, for a copy installed into site-packages (``pip install .``,
+    which holds the code but not the 79 MB of models), ./saved_networks when the command runs in a clone."""
+    given = os.environ.get(MODELS_ENV)
+    if given:
+        return Path(given).expanduser().resolve()
+    if SAVED_NETWORKS.is_dir():
+        return SAVED_NETWORKS
+    here = Path.cwd() / "saved_networks"
+    return here if here.is_dir() else SAVED_NETWORKS
+
+
+def no_shipped_model(what: str, folder: Path, shipped: list[str]) -> UserError:
+    """One line for a shipped model that is not where the package looks."""
+    root = models_root()
+    if not root.is_dir():
+        return UserError(f"no shipped models at {root}: they live in the saved_networks/ folder of a clone of the "
+                         f"repository; run there, set {MODELS_ENV}=/path/to/saved_networks, or give a model folder")
+    return UserError(f"no shipped model {what} in {folder.parent}; shipped: {', '.join(shipped) or 'none'} "
+                     f"(or give a model folder)")
 
 
 def shipped_dir(experiment: str, algo: str, config=None) -> Path:
     """saved_networks/EXPERIMENT/ALGO, or for Mario saved_networks/mario_ppo/WORLD-STAGE (one
     model per level: the experiment's ``shipped_by`` names the config fields; without a config, its
-    ``default`` folder)."""
+    ``default`` folder), under :func:`models_root`."""
     from rlcore.experiment import get_experiment
 
     shipped_by = get_experiment(experiment).shipped_by
+    root = models_root()
     if shipped_by is None:
-        return SAVED_NETWORKS / experiment / algo
+        return root / experiment / algo
     if config is None:
-        return SAVED_NETWORKS / experiment / shipped_by.default
-    return SAVED_NETWORKS / experiment / shipped_by.folder(config)
+        return root / experiment / shipped_by.default
+    return root / experiment / shipped_by.folder(config)
 
 
 

@@ -54,8 +54,8 @@ def dqn_model_dir(tmp_path):
     (["render", "lunar_lander", "sac"], "unknown algorithm 'sac'"),
     (["evaluate", "mario_ppo", "ppo", "--model", "/nonexistent/1-1"], "has no meta.json"),
     (["plot", "/nonexistent/run"], "no metrics.csv in /nonexistent/run"),
-    (["evaluate", "mario_ppo", "ppo", "--world", "8", "--stage", "4"], "no shipped model for level 8-4; "
-                                                                        "shipped levels: "),
+    (["evaluate", "mario_ppo", "ppo", "--world", "8", "--stage", "4"], "no shipped model for level 8-4 in "),
+    (["evaluate", "CartPole-v1", "dqn"], "no shipped model CartPole-v1 dqn in "),
     (["render", "lunar_lander", "dqn", "--world", "1"], "--world/--stage choose a Mario level"),
     (["evaluate", "mario_ppo", "ppo", "--world", "1", "--model", "x"], "either --model or --world/--stage"),
     (["evaluate", "mario_ppo", "ppo", "--stage", "0"], "argument --stage: 0 is invalid: allowed is a number "
