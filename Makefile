@@ -42,7 +42,7 @@ demo: $(CORE)
 # The suite on the CPU's cores (pytest-xdist; a test file stays on one worker, so its module fixtures, a
 # local Ray among them, are its own): 6 min 08 s on 2 cores, 15 min 16 s in one process (2026-11-27).
 test: $(ALL)
-	$(PY) -m pytest -q -n auto --maxprocesses 4 --dist loadfile
+	$(PY) -m pytest -q -n auto --maxprocesses 4 --dist loadfile --no-loadscope-reorder
 
 # Refresh the lock: every package at the newest version setup.cfg allows, installed into a fresh venv,
 # frozen into constraints.txt. Then `make test`, and commit the lock with what it changed.

@@ -1,11 +1,11 @@
 """Sweeps on a local Ray (2 CPUs, 127.0.0.1, one instance for this module): trials run to the end,
 survive a SIGKILL of their worker, stop at a checkpoint on Ctrl-C, resume without re-running
-finished trials; the report's statistics against direct computations."""
+finished trials, and leave no Ray process behind; the report of a finished sweep against its run
+folders. The tests that need no Ray of this module's own are in tests/test_sweep_without_ray.py."""
 import json
 import os
 import signal
 import subprocess
-import sys
 import threading
 import time
 from pathlib import Path
@@ -15,9 +15,8 @@ import pytest
 
 from rlcore import experiment as registry
 from rlcore.checkpoint import read_checkpoint_state
-from rlcore.report import aggregates, load_runs, probability_of_improvement, stratified_bootstrap_ci, summarize
-from rlcore.sweep import STOP_FILE, Sweep, parse_grid, parse_seeds, run_sweep, start_ray
-from tests.test_cli import run
+from rlcore.report import load_runs, summarize
+from rlcore.sweep import STOP_FILE, Sweep, run_sweep, start_ray
 
 ROOT = Path(__file__).resolve().parents[1]
 BUDGET = {"max_episodes": 40, "stop_score": 99.0, "checkpoint_every": 10}
@@ -187,169 +186,3 @@ def test_no_ray_process_is_left_behind(local_ray):
     assert not _ray_sockets()
     left = _ray_pids() - OTHERS_RAY
     assert not left, left
-
-
-# ------------------------------------------------------------------------- without Ray
-def test_bootstrap_ci_on_known_answers():
-    constant = np.full((8, 1), 3.0)
-    point, ci = stratified_bootstrap_ci(aggregates, constant, reps=200)
-    np.testing.assert_allclose(point, 3.0)
-    np.testing.assert_allclose(ci, 3.0)
-    scores = np.arange(1.0, 101.0)[:, None]
-    point, ci = stratified_bootstrap_ci(aggregates, scores, reps=2000)
-    np.testing.assert_allclose(point, [50.5, 50.5, 50.5])
-    # the mean of 1..100 has standard error 29.01 / 10: the 95% interval is about 50.5 +- 5.7
-    assert ci[0][0] == pytest.approx(50.5 - 5.7, abs=0.8) and ci[1][0] == pytest.approx(50.5 + 5.7, abs=0.8)
-    # skewed scores, as a 5-seed sweep gives: the median is the middle run, not the mean again
-    skewed = np.array([[500.0], [137.0], [500.0], [487.0], [278.0]])
-    # the IQM of 5 runs drops one at each end (scipy's trim_mean, as rliable)
-    np.testing.assert_allclose(aggregates(skewed), [380.4, 487.0, (278 + 487 + 500) / 3])
-    assert probability_of_improvement(scores + 1000, scores) == 1.0
-    assert probability_of_improvement(scores, scores) == pytest.approx(0.5)
-
-
-def test_a_sweep_moved_to_another_folder_resumes_where_it_now_is(tmp_path):
-    """A sweep kept in git (long_runs/sweeps/) resumes from a clone in another place."""
-    first = _sweep(tmp_path, "here")
-    Path(first.folder).mkdir()
-    first.save()
-    (tmp_path / "here").rename(tmp_path / "there")
-    assert Sweep.load(tmp_path / "there").folder == str((tmp_path / "there").resolve())
-
-
-def test_seeds_and_grid_parsing():
-    from rlcore.configs import DQNConfig
-
-    assert parse_seeds("0-4") == [0, 1, 2, 3, 4] and parse_seeds("0,3,7") == [0, 3, 7]
-    assert parse_grid(["lr=1e-4,3e-4", "hidden=64,64;128"], DQNConfig()) == {
-        "lr": [1e-4, 3e-4], "hidden": [(64, 64), (128,)]}
-
-
-@pytest.mark.parametrize("argv, message", [
-    (["sweep", "lunar_lander", "dqn", "--grid", "learning_rate=1e-3"], "'learning_rate' is not a hyperparameter"),
-    (["sweep", "lunar_lander", "dqn", "--grid", "gamma=0.9,1.5"], "--gamma 1.5 is invalid"),
-    (["sweep", "lunar_lander", "dqn", "--grid", "lr=fast"], "--grid 'lr=fast' is invalid"),
-    (["sweep", "lunar_lander", "dqn", "--grid", "keep_best=maybe"], "--grid 'keep_best=maybe' is invalid: 'maybe'"),
-    (["sweep", "lunar_lander", "dqn", "--seeds", "4-x"], "--seeds '4-x' is invalid"),
-    (["sweep", "lunar_lander", "dqn", "--seeds", "4-0"], "the range 4-0 runs downward; write 0-4"),
-    (["report", "/nonexistent/sweep"], "no sweep folder /nonexistent/sweep"),
-    (["sweep", "lunar_lander", "dqn", "--name", "../x"], "argument --name: '../x' is invalid: give a folder name"),
-    (["sweep", "lunar_lander", "dqn", "--name", ".."], "argument --name: '..' is invalid"),
-])
-def test_bad_sweep_values_are_one_line_and_exit_2(capsys, tmp_path, monkeypatch, argv, message):
-    monkeypatch.chdir(tmp_path)
-    named = argv[0] == "sweep" and "--name" not in argv
-    code, out, err = run(capsys, *argv, "--name", "x") if named else run(capsys, *argv)
-    assert code == 2 and message in err and len(err.strip().splitlines()) == 1, err
-    assert not (tmp_path / "sweeps").exists() and not (tmp_path / "x").exists()
-
-
-def test_report_groups_a_grid_sweep_by_setting(tmp_path):
-    from rlcore.report import markdown
-
-    # skewed scores, so mean, median and IQM differ and a mix-up of their names would show
-    for lr, scores in (("0.001", (137.0, 278.0, 487.0, 500.0, 500.0)), ("0.01", (600.0, 601.0, 650.0))):
-        for seed, score in enumerate(scores):
-            model = tmp_path / "grid" / f"lr={lr}__seed={seed}" / "model"
-            model.mkdir(parents=True)
-            (model / "meta.json").write_text(json.dumps({
-                "seed": seed, "env_steps": 100, "wall_seconds": 1.0,
-                "evaluation": {"episodes": 5, "mean": score}}))
-    result = summarize([tmp_path / "grid"], reps=200)
-    labels = [g["label"] for g in result["sweeps"]]
-    assert labels == ["grid [lr=0.001]", "grid [lr=0.01]"]
-    first = result["sweeps"][0]["aggregates"]
-    assert [first[k][0] for k in ("mean", "median", "iqm")] == pytest.approx([380.4, 487.0, 1265 / 3])
-    assert all(lo <= point <= hi and lo < hi for point, lo, hi in first.values())
-    assert result["sweeps"][1]["aggregates"]["median"][0] == 601.0
-    assert result["probability_of_improvement"][0] == 0.0  # every lr=0.001 run below every lr=0.01 run
-    text = markdown(result)
-    assert "P(grid [lr=0.001] > grid [lr=0.01]) = 0.000" in text
-    lo, hi = first["median"][1:]
-    assert f"| median | 487.000 | [{lo:.3f}, {hi:.3f}] |" in text and "| mean | 380.400 |" in text
-
-
-def test_report_keep_copies_what_the_report_reads_and_nothing_else(tmp_path, capsys):
-    sweep, kept = tmp_path / "sweeps" / "toy__dqn", tmp_path / "results" / "toy__dqn"
-    (sweep).mkdir(parents=True)
-    (sweep / "sweep.json").write_text(json.dumps({"experiment": "toy"}))
-    for seed, score in enumerate((100.0, 250.0, 300.0)):
-        run_dir = sweep / f"seed={seed}"
-        (run_dir / "model").mkdir(parents=True)
-        (run_dir / "model" / "meta.json").write_text(json.dumps({
-            "seed": seed, "env_steps": 1000 * (seed + 1), "wall_seconds": 2.0, "evaluation": {"episodes": 5, "mean": score}}))
-        (run_dir / "metrics.csv").write_text("episode,env_steps,av_latest_points\n1,10,1.0\n2,1000,%s\n" % score)
-        (run_dir / "evals.csv").write_text("env_steps,mean\n1000,%s\n" % score)
-        (run_dir / "checkpoint.npz").write_bytes(b"large")
-    code, out, err = run(capsys, "report", str(sweep), "--keep", str(kept), "--reps", "200")
-    assert code == 0, err
-    copied = sorted(str(p.relative_to(kept)) for p in kept.rglob("*") if p.is_file())
-    per_run = ["evals.csv", "metrics.csv", "model/meta.json"]
-    assert copied == sorted(["report.md", "report_curves.png", "sweep.json"]
-                            + [f"seed={s}/{name}" for s in range(3) for name in per_run])
-    assert not (sweep / "report.md").exists()  # the report is written where the copies are
-    again = summarize([kept], reps=200)
-    assert again["sweeps"][0]["aggregates"]["mean"][0] == pytest.approx(650.0 / 3)
-    assert [r["env_steps"] for r in load_runs(kept)] == [1000, 2000, 3000]
-    code, _, err = run(capsys, "report", str(sweep), str(kept), "--keep", str(tmp_path / "other"))
-    assert code == 2 and "--keep copies one sweep" in err and not (tmp_path / "other").exists()
-
-
-def test_report_refuses_a_folder_that_mixes_experiments_or_algorithms(tmp_path, capsys):
-    """`report runs/` over a user's runs of unlike tasks would average unlike scores: one line, exit 2."""
-    for name, experiment, algo, score in (("a", "lunar_lander", "dqn", 200.0), ("b", "cartpole", "a2c", 500.0),
-                                          ("c", "lunar_lander", "dqn", 250.0)):
-        (tmp_path / "runs" / name / "model").mkdir(parents=True)
-        (tmp_path / "runs" / name / "model" / "meta.json").write_text(json.dumps({
-            "experiment": experiment, "algo": algo, "seed": 0, "env_steps": 10, "wall_seconds": 1.0,
-            "evaluation": {"episodes": 5, "mean": score}}))
-    code, out, err = run(capsys, "report", str(tmp_path / "runs"))
-    assert code == 2 and len(err.strip().splitlines()) == 1, err
-    assert "holds runs of cartpole a2c and lunar_lander dqn" in err
-    assert not (tmp_path / "runs" / "report.md").exists()
-    (tmp_path / "runs" / "b" / "model" / "meta.json").unlink()  # the rest: one experiment and algorithm
-    assert [r["score"] for r in load_runs(tmp_path / "runs")] == [200.0, 250.0]
-
-
-def test_a_trial_killed_before_its_first_checkpoint_starts_over_without_its_old_rows(tmp_path):
-    """No checkpoint means the trial starts from episode 1 again: rows logged by the killed start are
-    not kept under the new run's (they would repeat episode numbers and mix two runs' curves)."""
-    import dataclasses
-
-    from rlcore.sweep import run_trial
-    sweep = _sweep(tmp_path, "early", seeds=(0,))
-    trial = tmp_path / "early" / "seed=0"
-    trial.mkdir(parents=True)
-    header = "episode,total_points,av_latest_points,target_ave_scores,env_steps,wall_seconds\n"
-    (trial / "metrics.csv").write_text(header + "1,-12345.0,-12345.0,,7,0.1\n2,-12345.0,-12345.0,,9,0.2\n")
-    run_trial({"seed": 0}, dataclasses.asdict(sweep), {"toy": "tests.toy"}, lambda metrics: None)
-    rows = (trial / "metrics.csv").read_text().splitlines()[1:]
-    episodes = [int(line.split(",")[0]) for line in rows]
-    assert episodes == list(range(1, len(episodes) + 1)) and len(episodes) >= 2
-    assert not any("-12345" in line for line in rows)
-
-
-def test_sigterm_to_the_sweeps_process_group_stops_its_trials_at_a_checkpoint(tmp_path):
-    """As `timeout` or a scheduler sends it: to the driver and every process it started. Ray's services
-    must not die under the trials (they started with the signal blocked); the driver stops the trials."""
-    from tests.test_stop_signals import group_is_gone
-
-    folder = tmp_path / "group"
-    proc = subprocess.Popen([sys.executable, "main.py", "sweep", "cartpole", "dqn", "--seeds", "0",
-                             "--episodes", "5000", "--dir", str(tmp_path), "--name", "group", "--num-cpus", "1"],
-                            cwd=ROOT, start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True)
-    _wait_for(folder / "seed=0" / "checkpoint.npz", timeout=240)
-    # the command imports ray.tune (its check for the sweep extra) before it starts Ray: still loopback only
-    group = set(subprocess.run(["pgrep", "-g", str(proc.pid)], capture_output=True, text=True).stdout.split())
-    sockets = [s for s in subprocess.run(["ss", "-tnlpH"], capture_output=True, text=True).stdout.splitlines()
-               if any(f"pid={pid}," in s for pid in group)]
-    outside = [s for s in sockets if s.split()[3].rsplit(":", 1)[0] not in LOOPBACK]
-    os.killpg(proc.pid, signal.SIGTERM)
-    out, err = proc.communicate(timeout=180)
-    assert proc.returncode == 130, err[-2000:]
-    assert sockets and not outside, outside or "no socket of the sweep's Ray found"
-    assert "seed=0: stopped at a checkpoint" in out, out
-    assert group_is_gone(proc.pid, timeout=30)
-    log = (folder / "trials.log").read_text()
-    assert log.count("started") == 1 and "failed" not in log
