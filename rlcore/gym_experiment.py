@@ -12,6 +12,9 @@ What fits (the agents read nothing of an env but its spaces):
     sac                                         Box actions with finite bounds (rescaled to [-1, 1],
                                                 the range of its tanh actor), vector observations
 
+A Discrete observation (FrozenLake's cell, Taxi's state number) is given to the networks one-hot, as a
+vector of n zeros and a one (Stable-Baselines3 does the same); the exported networks take that vector.
+
 A preset is the algorithm's config dataclass defaults, with episodes capped at the env's registered
 time limit, stopping once the last 100 episodes average the env's ``reward_threshold`` (when it has one)
 and the env pool in-process. Every field stays a flag (``--lr 3e-4``) or a keyword of
@@ -22,7 +25,7 @@ from __future__ import annotations
 import dataclasses
 import importlib
 import re
-from functools import partial
+from functools import cache, partial
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -105,9 +108,44 @@ def make_gym_env(render_mode: str | None = None, max_episode_steps: int | None =
     if module is not None:
         importlib.import_module(module)  # a spawned pool worker registers the user's env here
     env = gym.make(env_id, render_mode=render_mode, max_episode_steps=max_episode_steps)
+    if isinstance(env.observation_space, gym.spaces.Discrete):
+        env = OneHotObservation(env)
     if rescale_actions:
         env = gym.wrappers.RescaleAction(env, np.float32(-1.0), np.float32(1.0))
     return env
+
+
+def one_hot(observation: int, space: gymnasium.spaces.Discrete) -> np.ndarray:
+    """The observation ``observation`` of a Discrete ``space`` (which may start at a value other than 0)
+    as a float32 vector of ``space.n`` zeros with a one at its index."""
+    vector = np.zeros(int(space.n), np.float32)
+    vector[int(observation) - int(space.start)] = 1.0
+    return vector
+
+
+@cache
+def _one_hot_wrapper() -> type:
+    import gymnasium as gym
+
+    class OneHot(gym.ObservationWrapper):
+        """Discrete observations as one-hot vectors (a Box of n values in [0, 1])."""
+
+        def __init__(self, env: gymnasium.Env) -> None:
+            super().__init__(env)
+            discrete = env.observation_space
+            if not isinstance(discrete, gym.spaces.Discrete):
+                raise TypeError(f"one-hot needs a Discrete observation space, not {discrete}")
+            self.discrete = discrete
+            self.observation_space = gym.spaces.Box(0.0, 1.0, (int(discrete.n),), np.float32)
+
+        def observation(self, observation: int) -> np.ndarray:
+            return one_hot(observation, self.discrete)
+    return OneHot
+
+
+def OneHotObservation(env: gymnasium.Env) -> gymnasium.Env:  # noqa: N802 (a wrapper, named as one)
+    """``env`` with its Discrete observations given one-hot; Gymnasium is imported only when needed."""
+    return _one_hot_wrapper()(env)
 
 
 # ---------------------------------------------------------------- what fits
@@ -168,6 +206,7 @@ def _build(name: str) -> Experiment:
     env = make_gym_env(name=name)
     try:
         obs_space, act_space = env.observation_space, env.action_space
+        one_hot_obs = type(env.unwrapped.observation_space).__name__ == "Discrete"  # given one-hot
         fps = int(env.metadata.get("render_fps") or 30)
     finally:
         env.close()
@@ -192,7 +231,8 @@ def _build(name: str) -> Experiment:
         unfit=unfit,
         env_record={"gymnasium_id": spec.id, "entry_point": entry_point,
                     "kwargs": _jsonable(spec.kwargs), "max_episode_steps": spec.max_episode_steps,
-                    "reward_threshold": spec.reward_threshold, "actions_rescaled_to": [-1, 1] if rescale else None},
+                    "reward_threshold": spec.reward_threshold, "actions_rescaled_to": [-1, 1] if rescale else None,
+                    "observations_one_hot": one_hot_obs},
     )
 
 

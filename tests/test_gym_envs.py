@@ -1,5 +1,6 @@
 """Any Gymnasium id trains without an experiment package (issue 47): Acrobot-v1 (dqn, a2c, ppo),
-Pendulum-v1 (sac), CartPole-v1 (ppo) and a user's own registered env, each a short run end to end
+Pendulum-v1 (sac), CartPole-v1 (ppo), FrozenLake-v1 (dqn, its Discrete observations one-hot) and a user's
+own registered env, each a short run end to end
 (train, final evaluation, load, evaluate; render and export on some), and a mismatch of env and
 algorithm is one line and exit status 2 before any run folder exists."""
 import json
@@ -52,6 +53,27 @@ def test_acrobot(tmp_path, algo, budget):
     assert max(r["length"] for r in run.evaluation["per_episode"]) <= 500
     result = api.evaluate(policy, episodes=2, seed_base=5)
     assert result["seeds"] == "5..6" and result["episodes"] == 2 and "greedy return" in result["line"]
+
+
+def test_one_hot_is_the_index_of_a_discrete_observation():
+    from rlcore.gym_experiment import OneHotObservation, one_hot
+
+    assert one_hot(2, gym.spaces.Discrete(4)).tolist() == [0, 0, 1, 0]
+    assert one_hot(-1, gym.spaces.Discrete(3, start=-1)).tolist() == [1, 0, 0]  # a space starting at -1
+    env = OneHotObservation(gym.make("FrozenLake-v1"))
+    obs, _ = env.reset(seed=0)
+    assert env.observation_space == gym.spaces.Box(0.0, 1.0, (16,), np.float32) and env.observation_space.contains(obs)
+    assert obs.dtype == np.float32 and obs.sum() == 1.0 and obs[0] == 1.0  # FrozenLake starts in cell 0
+    env.close()
+
+
+def test_frozen_lake_dqn_sees_its_cells_one_hot(tmp_path):
+    """A Discrete observation space (FrozenLake's 16 cells) is given to the networks one-hot and recorded."""
+    run = api.train("FrozenLake-v1", "dqn", run_dir=tmp_path / "run", episodes=5, hidden=(16,),
+                    final_eval_episodes=2, progress=False)
+    policy = check_run(run, "FrozenLake-v1", "dqn", 2)
+    assert run.meta["env"]["observations_one_hot"] is True
+    assert policy.make_env().observation_space.shape == (16,)
 
 
 def test_pendulum_sac_rescales_actions(tmp_path):
@@ -127,8 +149,8 @@ def test_registered_by_id_alone_reloads_from_its_record(tmp_path, capsys):
                           "a2c, ppo"),
     ("Pendulum-v1", "dqn", "error: dqn does not fit Pendulum-v1: it needs discrete actions"),
     ("CarRacing-v3", "dqn", "error: dqn does not fit CarRacing-v3: it needs discrete actions"),
-    ("FrozenLake-v1", "ppo", "error: ppo does not fit FrozenLake-v1: it needs vector observations (a 1-D Box) "
-                             "or uint8 images"),
+    ("Blackjack-v1", "ppo", "error: ppo does not fit Blackjack-v1: it needs vector observations (a 1-D Box) "
+                            "or uint8 images"),
     ("NoSuchEnv-v0", "dqn", "error: NoSuchEnv-v0 is not a registered Gymnasium id"),
     ("no_such_module:Thing-v0", "dqn", "error: cannot import 'no_such_module'"),
 ])
