@@ -43,17 +43,24 @@ def fill(disk: Path, leave: int) -> Path:
 
 
 def main_py(*argv: str) -> subprocess.CompletedProcess:
+    """A command in a process of its own: its whole stderr is what a user would see."""
     return subprocess.run([sys.executable, "main.py", *argv], cwd=ROOT, capture_output=True, text=True,
                           timeout=300)
+
+
+def in_process(*argv: str) -> int:
+    """A command whose output is not under test, in this process (no second TensorFlow start-up)."""
+    from rlcore import cli
+
+    return cli.main(list(argv))
 
 
 def test_a_full_disk_is_one_line_and_the_last_checkpoint_resumes(small_disk):
     """Full at a checkpoint (64 kB left: the rows fit, the Q-networks, Adam and replay do not), then full
     at the first CSV row (nothing left): each is one line, and the run resumes once there is room."""
     run_dir = small_disk / "run"
-    first = main_py("train", "cartpole", "dqn", "--episodes", "3", "--checkpoint-every", "1",
-                    "--run-dir", str(run_dir), *QUICK)
-    assert first.returncode == 0, first.stderr
+    assert in_process("train", "cartpole", "dqn", "--episodes", "3", "--checkpoint-every", "1",
+                      "--run-dir", str(run_dir), *QUICK) == 0
     good = (run_dir / "checkpoint.npz").read_bytes()
     for leave in (64_000, 0):
         filler = fill(small_disk, leave)
@@ -65,14 +72,12 @@ def test_a_full_disk_is_one_line_and_the_last_checkpoint_resumes(small_disk):
         assert not [p for p in run_dir.rglob("*") if ".tmp" in p.name], "a temporary file was left behind"
         assert (run_dir / "checkpoint.npz").read_bytes() == good
         filler.unlink()
-    again = main_py("train", "cartpole", "dqn", "--resume", str(run_dir), "--episodes", "5", *QUICK)
-    assert again.returncode == 0, again.stderr
+    assert in_process("train", "cartpole", "dqn", "--resume", str(run_dir), "--episodes", "5", *QUICK) == 0
 
 
 def test_a_read_only_disk_is_one_clear_error_and_the_run_resumes_once_writable(small_disk):
     run_dir = small_disk / "run"
-    first = main_py("train", "cartpole", "dqn", "--episodes", "2", "--run-dir", str(run_dir), *QUICK)
-    assert first.returncode == 0, first.stderr
+    assert in_process("train", "cartpole", "dqn", "--episodes", "2", "--run-dir", str(run_dir), *QUICK) == 0
     subprocess.run(["mount", "-o", "remount,ro", str(small_disk)], check=True)
     try:
         refused = main_py("train", "cartpole", "dqn", "--resume", str(run_dir), "--episodes", "4", *QUICK)
@@ -84,8 +89,7 @@ def test_a_read_only_disk_is_one_clear_error_and_the_run_resumes_once_writable(s
         assert out.returncode == 2 and "--out" in out.stderr and "Read-only" in out.stderr, out.stderr
     finally:
         subprocess.run(["mount", "-o", "remount,rw", str(small_disk)], check=True)
-    again = main_py("train", "cartpole", "dqn", "--resume", str(run_dir), "--episodes", "4", *QUICK)
-    assert again.returncode == 0, again.stderr
+    assert in_process("train", "cartpole", "dqn", "--resume", str(run_dir), "--episodes", "4", *QUICK) == 0
 
 
 def test_write_failed_names_the_path_and_what_to_do(tmp_path):
