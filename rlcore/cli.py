@@ -342,6 +342,8 @@ def main(argv: list[str] | None = None) -> int:
             import shlex          # the arguments of the process that called it
             args.command_line = shlex.join(["python", "main.py", *argv])
         if args.command in ("train", "evaluate", "render", "export"):
+            from rlcore.trainers.stopping import guard_terminal_streams
+            guard_terminal_streams()  # a terminal that closes (SIGHUP) must not cost a run its checkpoint
             from rlcore.extras import require_experiment
             _register_recorded_env(getattr(args, "model", None))
             require_experiment(args.experiment)  # a missing extra (mario, minitaur): one line, no run folder

@@ -33,7 +33,7 @@ from pathlib import Path
 
 from rlcore.atomic import writable_folder, write_json
 from rlcore.errors import UserError
-from rlcore.trainers.stopping import STOP_SIGNALS
+from rlcore.trainers.stopping import STOP_SIGNALS, detach_from_terminal
 
 SWEEP_FILE = "sweep.json"
 STOP_FILE = "STOP"
@@ -268,8 +268,9 @@ def loopback_only() -> None:
 
 @contextlib.contextmanager
 def ignoring_stop_signals():
-    """SIGINT and SIGTERM blocked while local Ray starts its services, which inherit the mask: a
-    signal to the whole process group (Ctrl-C, timeout, a scheduler) then reaches only the driver,
+    """The stop signals (SIGINT, SIGTERM, SIGHUP) blocked while local Ray starts its services, which
+    inherit the mask: a signal to the whole process group (Ctrl-C, timeout, a scheduler, a terminal
+    that closes) then reaches only the driver,
     which stops every trial at a checkpoint and shuts Ray down, instead of killing Ray's services under
     the trials. (Ray blocks SIGINT in its services itself; SIGTERM ended them at once.)"""
     blocked = signal.pthread_sigmask(signal.SIG_BLOCK, set(STOP_SIGNALS))
@@ -295,10 +296,13 @@ def run_sweep(sweep: Sweep, address: str | None = None, num_cpus: int | None = N
     started = start_ray(address, num_cpus)
     from ray import tune
 
-    def on_stop_signal(signum, frame):  # Ctrl-C or SIGTERM: a killed driver would orphan Ray's workers
+    def on_stop_signal(signum, frame):  # Ctrl-C, SIGTERM, SIGHUP: a killed driver would orphan Ray's workers
         (folder / STOP_FILE).touch()
-        print(f"\n{STOP_SIGNALS[signum]}: every running trial stops at its next checkpoint; --resume continues "
-              "the sweep", file=sys.stderr)
+        if signum == signal.SIGHUP:
+            detach_from_terminal()
+        with contextlib.suppress(OSError):
+            print(f"\n{STOP_SIGNALS[signum]}: every running trial stops at its next checkpoint; --resume "
+                  "continues the sweep", file=sys.stderr)
     previous = {number: signal.signal(number, on_stop_signal) for number in STOP_SIGNALS}
     try:
         trainable = tune.with_parameters(_trainable, sweep=asdict(sweep),

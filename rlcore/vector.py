@@ -36,13 +36,16 @@ class EnvWorkerDied(UserError):
 
 
 class IgnoringStopSignals:
-    """A picklable env factory that first makes its (worker) process ignore SIGINT and SIGTERM."""
+    """A picklable env factory that first makes its (worker) process ignore the stop signals (SIGINT,
+    SIGTERM, SIGHUP): the trainer that owns the pool stops at a checkpoint and then closes it."""
 
     def __init__(self, make_env: Callable[[], gym.Env]):
         self.make_env = make_env
 
     def __call__(self) -> gym.Env:
-        for number in (signal.SIGINT, signal.SIGTERM):
+        from rlcore.trainers.stopping import STOP_SIGNALS
+
+        for number in STOP_SIGNALS:
             signal.signal(number, signal.SIG_IGN)
         return self.make_env()
 

@@ -1,6 +1,6 @@
 """When a run stops. Two kinds of reason, kept apart:
 
-- :class:`StopRequest`: someone asked (Ctrl-C or SIGTERM, or a sweep's stop file). The loop stops at
+- :class:`StopRequest`: someone asked (Ctrl-C, SIGTERM or SIGHUP, or a sweep's stop file). The loop stops at
   its next safe point, writes a checkpoint and raises :class:`Interrupted`; the run can be resumed.
 - :class:`StopRules`: the run is done (a budget is spent or a goal reached). It then writes its
   model folder; ``meta.json`` records which rule ended it.
@@ -8,7 +8,11 @@
 from __future__ import annotations
 
 import contextlib
+import errno
+import os
 import signal
+import stat
+import sys
 import threading
 import time
 from pathlib import Path
@@ -16,8 +20,65 @@ from pathlib import Path
 from tqdm.auto import tqdm  # a widget in a notebook, text in a terminal
 
 
-# each asks for a stop at the next safe point, with a checkpoint
-STOP_SIGNALS = {signal.SIGINT: "Ctrl-C", signal.SIGTERM: "SIGTERM"}
+# each asks for a stop at the next safe point, with a checkpoint (SIGHUP: the terminal closed, an ssh
+# connection dropped)
+STOP_SIGNALS = {signal.SIGINT: "Ctrl-C", signal.SIGTERM: "SIGTERM", signal.SIGHUP: "SIGHUP"}
+
+
+def detach_from_terminal() -> None:
+    """After SIGHUP the terminal is gone and every write to it fails (EIO), which would end the run
+    before its checkpoint: standard output and error that were that terminal go to /dev/null from here
+    on (as under nohup). Pipes and files are kept, so a log still gets the last lines."""
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        for fd in (1, 2):
+            with contextlib.suppress(OSError):
+                if stat.S_ISCHR(os.fstat(fd).st_mode):  # a terminal (isatty() fails once it hung up)
+                    os.dup2(devnull, fd)
+    finally:
+        os.close(devnull)
+
+
+class HangupSafe:
+    """A terminal's text stream whose writes, once the terminal has hung up (they fail with EIO), go
+    nowhere instead of raising: the write of a progress bar may come before the SIGHUP handler runs, and
+    must not end the run before its checkpoint. Everything else is the stream's own."""
+
+    def __init__(self, stream):
+        self._stream = stream
+        self.hung_up = False
+
+    def _guarded(self, call, *args):
+        if not self.hung_up:
+            try:
+                return call(*args)
+            except OSError as exc:
+                if exc.errno != errno.EIO:
+                    raise
+                self.hung_up = True
+        return None
+
+    def write(self, text: str) -> int:
+        self._guarded(self._stream.write, text)
+        return len(text)
+
+    def flush(self) -> None:
+        self._guarded(self._stream.flush)
+
+    def isatty(self) -> bool:
+        return not self.hung_up and self._stream.isatty()
+
+    def __getattr__(self, name):
+        return getattr(self._stream, name)
+
+
+def guard_terminal_streams() -> None:
+    """Standard output and error, where they are terminals, become :class:`HangupSafe` (the commands
+    that train call it first, before any progress bar takes hold of ``sys.stderr``)."""
+    for name in ("stdout", "stderr"):
+        stream = getattr(sys, name)
+        if not isinstance(stream, HangupSafe) and getattr(stream, "isatty", lambda: False)():
+            setattr(sys, name, HangupSafe(stream))
 
 
 class Interrupted(Exception):
@@ -46,14 +107,17 @@ class StopRequest:
 
     @contextlib.contextmanager
     def catching_stop_signals(self):
-        """The first Ctrl-C or SIGTERM (``kill``, ``timeout``, a job scheduler) sets ``requested``: the
-        loop checkpoints and stops. A second one aborts without saving."""
+        """The first Ctrl-C, SIGTERM (``kill``, ``timeout``, a job scheduler) or SIGHUP (the terminal
+        closed) sets ``requested``: the loop checkpoints and stops. A second one aborts without saving."""
         def handler(signum, frame):
+            if signum == signal.SIGHUP:
+                detach_from_terminal()
             if self.requested:
                 raise KeyboardInterrupt
             self.requested = True
-            tqdm.write(f"\n{STOP_SIGNALS[signum]}: stopping at the next safe point and saving a checkpoint "
-                       "(a second one aborts without saving)")
+            with contextlib.suppress(OSError):  # a terminal that is gone must not cost the checkpoint
+                tqdm.write(f"\n{STOP_SIGNALS[signum]}: stopping at the next safe point and saving a checkpoint "
+                           "(a second one aborts without saving)")
         if threading.current_thread() is not threading.main_thread():
             yield  # a Ray trial runs in a worker thread: its sweep stops it through the stop file
             return
