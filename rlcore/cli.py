@@ -241,6 +241,10 @@ def cmd_status(args) -> int:
     from rlcore.status import run_status
 
     run_dir = Path(args.run_dir)
+    if (run_dir / "sweep.json").is_file():  # a sweep's folder: a line per trial
+        from rlcore.status import sweep_status
+        print("\n".join(sweep_status(run_dir)))
+        return 0
     about = _run_folder(run_dir)
     print("\n".join(run_status(run_dir, get_experiment(about["experiment"]), about, args.block, args.blocks,
                                       args.rollout_block)))

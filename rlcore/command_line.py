@@ -207,7 +207,8 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
                                         "for PPO, per block of rollouts, the same shares beside "
                                         "the update sizes, learning rate and entropy weight; "
                                         "then the last periodic evaluations.")
-    status.add_argument("run_dir", help="a run folder, e.g. long_runs/mario_ppo/2-2")
+    status.add_argument("run_dir", help="a run folder, e.g. long_runs/mario_ppo/2-2, or a sweep's folder "
+                                        "(a line per trial)")
     status.add_argument("--block", type=COUNT, default=200, help="episodes per block (default 200)")
     status.add_argument("--blocks", type=COUNT, default=6, help="how many of the newest blocks (default 6)")
     status.add_argument("--rollout-block", type=COUNT, default=20,

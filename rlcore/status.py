@@ -12,6 +12,7 @@ finished. TensorFlow-free.
 """
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import pandas as pd
@@ -169,3 +170,31 @@ def _partial_between(df: pd.DataFrame, experiment, part: pd.DataFrame) -> pd.Dat
         return None
     between = df["episode"].between(part["episode"].iloc[0], part["episode"].iloc[-1])
     return df[between & (df[key] == 1)]
+
+
+def sweep_status(folder: str | Path) -> list[str]:
+    """What ``main.py status SWEEP`` prints: the sweep, then a line per trial (finished with its final
+    score, stopped or running at a checkpoint with its last periodic evaluation, or not started)."""
+    from rlcore.checkpoint import read_checkpoint_state
+    from rlcore.sweep import Sweep, trial_name
+    from rlcore.trainers.spec import CHECKPOINT_FILE
+
+    sweep = Sweep.load(Path(folder))
+    trials = [trial_name(t) for t in sweep.trials()]
+    lines = [f"sweep {sweep.name}: {sweep.experiment} {sweep.algo}, {len(trials)} trials"]
+    for name in trials:
+        trial = Path(sweep.folder) / name
+        meta = trial / "model" / "meta.json"
+        if meta.is_file():
+            about = json.loads(meta.read_text())
+            score = (about.get("evaluation") or {}).get("mean")
+            lines.append(f"  {name}: finished at {about['env_steps']:,} env steps"
+                         + (f", final score {score:.2f} on unseen seeds" if score is not None else ""))
+        elif (trial / CHECKPOINT_FILE).is_file():
+            state = read_checkpoint_state(trial / CHECKPOINT_FILE)
+            last = evaluation_lines(trial / "evals.csv", last=1)
+            lines.append(f"  {name}: checkpoint at {state['env_steps']:,} env steps, "
+                         f"{state.get('wall_seconds', 0) / 3600:.1f} h" + (f"; last {last[0]}" if last else ""))
+        else:
+            lines.append(f"  {name}: not started")
+    return lines

@@ -182,3 +182,26 @@ def test_sigterm_to_the_sweeps_process_group_stops_its_trials_at_a_checkpoint(tm
     assert group_is_gone(proc.pid, timeout=30)
     log = (folder / "trials.log").read_text()
     assert log.count("started") == 1 and "failed" not in log
+
+
+def test_status_of_a_sweep_folder_is_a_line_per_trial(tmp_path, capsys):
+    sweep = _sweep(tmp_path, "st", seeds=(0, 1, 2))
+    Path(sweep.folder).mkdir()
+    sweep.save()
+    done = tmp_path / "st" / "seed=0" / "model"
+    done.mkdir(parents=True)
+    (done / "meta.json").write_text(json.dumps({"env_steps": 1200, "evaluation": {"mean": 9.5}}))
+    running = tmp_path / "st" / "seed=1"
+    running.mkdir()
+    state = {"env_steps": 700, "wall_seconds": 7200.0, "checkpoint_version": 2}
+    np.savez(running / "checkpoint.npz", state_json=np.frombuffer(json.dumps(state).encode(), np.uint8))
+    (running / "evals.csv").write_text("env_steps,episode,eval_mean,eval_std,eval_time_limit_share\n"
+                                       "500,9,3.25,0.5,0.4\n")
+    code, out, err = run(capsys, "status", str(tmp_path / "st"))
+    assert code == 0, err
+    assert out.splitlines() == [
+        "sweep st: toy dqn, 3 trials",
+        "  seed=0: finished at 1,200 env steps, final score 9.50 on unseen seeds",
+        "  seed=1: checkpoint at 700 env steps, 2.0 h; last evaluation at env step 500: mean 3.25 +- 0.50, "
+        "40% of its episodes to the time limit",
+        "  seed=2: not started"]
