@@ -162,7 +162,9 @@ def run_trial(trial: dict, sweep: dict, modules: dict, report) -> dict:
     try:
         with hold_run_folder(run_dir):  # one writer: a trial restarted while its old worker lives is refused
             (run_dir / "worker.pid").write_text(f"{os.getpid()}\n")
-            return _train_trial(trial, sweep, run_dir, report)
+            result = _train_trial(trial, sweep, run_dir, report)
+        log_trial(sweep, trial, "stopped at a checkpoint" if result.get("interrupted") else "finished")
+        return result
     except UserError as exc:  # a bad value, a diverged loss, a busy folder: a retry would fail the same way
         log_trial(sweep, trial, f"failed: {exc}")
         return {"error": str(exc), "failed": 1}

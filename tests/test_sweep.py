@@ -78,6 +78,8 @@ def test_a_two_seed_sweep_runs_to_the_end_and_its_report_matches_the_run_folders
     assert all(r["error"] is None and r["finished"] == 1 for r in rows), rows
     metas = [json.loads((tmp_path / "two" / t / "model" / "meta.json").read_text()) for t in ("seed=0", "seed=1")]
     assert [m["seed"] for m in metas] == [0, 1] and all(m["evaluation"]["episodes"] == 5 for m in metas)
+    log = (tmp_path / "two" / "trials.log").read_text()
+    assert log.count(" started\n") == 2 and log.count(" finished\n") == 2, log
     scores = np.array([[m["evaluation"]["mean"]] for m in metas])
     result = summarize([tmp_path / "two"], reps=500)
     (mean, median, iqm) = (result["sweeps"][0]["aggregates"][k][0] for k in ("mean", "median", "iqm"))

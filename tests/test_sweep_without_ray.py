@@ -182,6 +182,7 @@ def test_sigterm_to_the_sweeps_process_group_stops_its_trials_at_a_checkpoint(tm
     assert group_is_gone(proc.pid, timeout=30)
     log = (folder / "trials.log").read_text()
     assert log.count("started") == 1 and "failed" not in log
+    assert log.splitlines()[-1].endswith(" seed=0 pid " + log.split()[3] + " stopped at a checkpoint"), log
 
 
 def test_status_of_a_sweep_folder_is_a_line_per_trial(tmp_path, capsys):
