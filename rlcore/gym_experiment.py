@@ -25,7 +25,7 @@ from __future__ import annotations
 import dataclasses
 import importlib
 import re
-from functools import cache, partial
+from functools import partial
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -123,29 +123,15 @@ def one_hot(observation: int, space: gymnasium.spaces.Discrete) -> np.ndarray:
     return vector
 
 
-@cache
-def _one_hot_wrapper() -> type:
+def OneHotObservation(env: gymnasium.Env) -> gymnasium.Env:  # noqa: N802 (a wrapper, named as one)
+    """``env`` with its Discrete observations given one-hot, as a Box of n values in [0, 1]."""
     import gymnasium as gym
 
-    class OneHot(gym.ObservationWrapper):
-        """Discrete observations as one-hot vectors (a Box of n values in [0, 1])."""
-
-        def __init__(self, env: gymnasium.Env) -> None:
-            super().__init__(env)
-            discrete = env.observation_space
-            if not isinstance(discrete, gym.spaces.Discrete):
-                raise TypeError(f"one-hot needs a Discrete observation space, not {discrete}")
-            self.discrete = discrete
-            self.observation_space = gym.spaces.Box(0.0, 1.0, (int(discrete.n),), np.float32)
-
-        def observation(self, observation: int) -> np.ndarray:
-            return one_hot(observation, self.discrete)
-    return OneHot
-
-
-def OneHotObservation(env: gymnasium.Env) -> gymnasium.Env:  # noqa: N802 (a wrapper, named as one)
-    """``env`` with its Discrete observations given one-hot; Gymnasium is imported only when needed."""
-    return _one_hot_wrapper()(env)
+    space = env.observation_space
+    if not isinstance(space, gym.spaces.Discrete):
+        raise TypeError(f"one-hot needs a Discrete observation space, not {space}")
+    return gym.wrappers.TransformObservation(env, partial(one_hot, space=space),
+                                             gym.spaces.Box(0.0, 1.0, (int(space.n),), np.float32))
 
 
 # ---------------------------------------------------------------- what fits
