@@ -222,10 +222,7 @@ def model_folder(model: str | os.PathLike[str] | tuple[str, str]) -> Path:
             folder = shipping.shipped_dir(name, which)
         else:
             folder = shipping.models_root() / name / which
-        if not (folder / "meta.json").is_file():
-            shipped = sorted(p.parent.name for p in folder.parent.glob("*/meta.json"))
-            raise shipping.no_shipped_model(f"{name} {which}", folder, shipped)
-        return folder
+        return shipping.require_shipped(folder, f"{name} {which}")
     folder = Path(model)
     finished = folder / "model"
     if (finished / "meta.json").is_file() and not (folder / "meta.json").is_file():

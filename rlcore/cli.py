@@ -102,11 +102,8 @@ def _model_dir(args) -> Path:
         finished = folder / "model"  # a finished run's folder: its model
         return finished if (finished / "meta.json").is_file() and not (folder / "meta.json").is_file() else folder
     if level == (None, None):
-        folder = shipping.shipped_dir(args.experiment, args.algo)
-        if not (folder / "meta.json").is_file():
-            shipped = sorted(p.parent.name for p in folder.parent.glob("*/meta.json"))
-            raise shipping.no_shipped_model(f"{args.experiment} {args.algo}", folder, shipped)
-        return folder
+        return shipping.require_shipped(shipping.shipped_dir(args.experiment, args.algo),
+                                        f"{args.experiment} {args.algo}")
     if exp.shipped_by is None:
         raise UserError(f"--world/--stage choose a Mario level; {exp.name} ships one model per algorithm")
     if args.model:
@@ -115,10 +112,7 @@ def _model_dir(args) -> Path:
 
     folder = shipping.shipped_dir(exp.name, args.algo, SimpleNamespace(world=args.world or 1,
                                                                        stage=args.stage or 1))
-    if not (folder / "meta.json").is_file():
-        shipped = sorted(p.parent.name for p in folder.parent.glob("*-*/meta.json"))
-        raise shipping.no_shipped_model(f"for level {folder.name}", folder, shipped)
-    return folder
+    return shipping.require_shipped(folder, f"for level {folder.name}")
 
 
 @contextlib.contextmanager

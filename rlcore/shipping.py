@@ -29,14 +29,18 @@ def models_root() -> Path:
     return here if here.is_dir() else SAVED_NETWORKS
 
 
-def no_shipped_model(what: str, folder: Path, shipped: list[str]) -> UserError:
-    """One line for a shipped model that is not where the package looks."""
+def require_shipped(folder: Path, what: str) -> Path:
+    """``folder`` if it holds a shipped model, else one line: where shipped models live when there are
+    none at all, or which of its neighbours are shipped (``what`` names the model asked for)."""
+    if (folder / "meta.json").is_file():
+        return folder
     root = models_root()
     if not root.is_dir():
-        return UserError(f"no shipped models at {root}: they live in the saved_networks/ folder of a clone of the "
-                         f"repository; run there, set {MODELS_ENV}=/path/to/saved_networks, or give a model folder")
-    return UserError(f"no shipped model {what} in {folder.parent}; shipped: {', '.join(shipped) or 'none'} "
-                     f"(or give a model folder)")
+        raise UserError(f"no shipped models at {root}: they live in the saved_networks/ folder of a clone of the "
+                        f"repository; run there, set {MODELS_ENV}=/path/to/saved_networks, or give a model folder")
+    shipped = sorted(p.parent.name for p in folder.parent.glob("*/meta.json"))
+    raise UserError(f"no shipped model {what} in {folder.parent}; shipped: {', '.join(shipped) or 'none'} "
+                    f"(or give a model folder)")
 
 
 def shipped_dir(experiment: str, algo: str, config=None) -> Path:

@@ -176,7 +176,7 @@ def sweep_status(folder: str | Path) -> list[str]:
     """What ``main.py status SWEEP`` prints: the sweep, then a line per trial (finished with its final
     score, stopped or running at a checkpoint with its last periodic evaluation, or not started)."""
     from rlcore.checkpoint import read_checkpoint_state
-    from rlcore.sweep import Sweep, trial_name
+    from rlcore.sweep import Sweep, final_metrics, trial_name
     from rlcore.trainers.spec import CHECKPOINT_FILE
 
     sweep = Sweep.load(Path(folder))
@@ -186,10 +186,10 @@ def sweep_status(folder: str | Path) -> list[str]:
         trial = Path(sweep.folder) / name
         meta = trial / "model" / "meta.json"
         if meta.is_file():
-            about = json.loads(meta.read_text())
-            score = (about.get("evaluation") or {}).get("mean")
-            lines.append(f"  {name}: finished at {about['env_steps']:,} env steps"
-                         + (f", final score {score:.2f} on unseen seeds" if score is not None else ""))
+            final = final_metrics(json.loads(meta.read_text()))  # as the sweep reports it (Mario: flag share)
+            lines.append(f"  {name}: finished at {final['env_steps']:,} env steps"
+                         + (f", final score {final['final_score']:.2f} on unseen seeds"
+                            if final["final_score"] == final["final_score"] else ""))  # NaN: not evaluated
         elif (trial / CHECKPOINT_FILE).is_file():
             state = read_checkpoint_state(trial / CHECKPOINT_FILE)
             last = evaluation_lines(trial / "evals.csv", last=1)

@@ -191,7 +191,7 @@ def test_status_of_a_sweep_folder_is_a_line_per_trial(tmp_path, capsys):
     sweep.save()
     done = tmp_path / "st" / "seed=0" / "model"
     done.mkdir(parents=True)
-    (done / "meta.json").write_text(json.dumps({"env_steps": 1200, "evaluation": {"mean": 9.5}}))
+    (done / "meta.json").write_text(json.dumps({"env_steps": 1200, "wall_seconds": 60.0, "evaluation": {"mean": 9.5}}))
     running = tmp_path / "st" / "seed=1"
     running.mkdir()
     state = {"env_steps": 700, "wall_seconds": 7200.0, "checkpoint_version": 2}
