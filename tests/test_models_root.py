@@ -27,7 +27,9 @@ def test_deeprl_models_names_the_folder(installed_apart, monkeypatch, capsys):
     monkeypatch.setenv(shipping.MODELS_ENV, str(models))
     assert api.load(("cartpole", "dqn")).model_dir == models / "cartpole" / "dqn"
     assert cli.main(["evaluate", "cartpole", "dqn", "--episodes", "1"]) == 0
-    assert "greedy return 500.0" in capsys.readouterr().out
+    # the model evaluated is the one in $DEEPRL_MODELS (its score is not the question here, and a score
+    # recorded on one CPU need not repeat exactly on another)
+    assert f"cartpole dqn ({models / 'cartpole' / 'dqn'}): greedy return " in capsys.readouterr().out
 
 
 def test_a_clone_s_saved_networks_is_found_from_where_the_command_runs(installed_apart):
