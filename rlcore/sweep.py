@@ -33,7 +33,7 @@ from pathlib import Path
 
 from rlcore.atomic import writable_folder, write_json
 from rlcore.errors import UserError
-from rlcore.trainers.stopping import STOP_SIGNALS, detach_from_terminal
+from rlcore.trainers.stopping import STOP_SIGNALS, announce_stop
 
 SWEEP_FILE = "sweep.json"
 STOP_FILE = "STOP"
@@ -300,11 +300,8 @@ def run_sweep(sweep: Sweep, address: str | None = None, num_cpus: int | None = N
 
     def on_stop_signal(signum, frame):  # Ctrl-C, SIGTERM, SIGHUP: a killed driver would orphan Ray's workers
         (folder / STOP_FILE).touch()
-        if signum == signal.SIGHUP:
-            detach_from_terminal()
-        with contextlib.suppress(OSError):
-            print(f"\n{STOP_SIGNALS[signum]}: every running trial stops at its next checkpoint; --resume "
-                  "continues the sweep", file=sys.stderr)
+        announce_stop(signum, "every running trial stops at its next checkpoint; --resume continues the sweep",
+                      write=lambda text: print(text, file=sys.stderr))
     previous = {number: signal.signal(number, on_stop_signal) for number in STOP_SIGNALS}
     try:
         trainable = tune.with_parameters(_trainable, sweep=asdict(sweep),

@@ -39,6 +39,15 @@ def detach_from_terminal() -> None:
         os.close(devnull)
 
 
+def announce_stop(signum: int, text: str, write=tqdm.write) -> None:
+    """A stop handler's message (a run's, a sweep driver's), said so that a terminal that hung up (SIGHUP)
+    cannot make the saying fail: its streams go to /dev/null first, and a failed write is dropped."""
+    if signum == signal.SIGHUP:
+        detach_from_terminal()
+    with contextlib.suppress(OSError):
+        write(f"\n{STOP_SIGNALS[signum]}: {text}")
+
+
 class HangupSafe:
     """A terminal's text stream whose writes, once the terminal has hung up (they fail with EIO), go
     nowhere instead of raising: the write of a progress bar may come before the SIGHUP handler runs, and
@@ -110,14 +119,11 @@ class StopRequest:
         """The first Ctrl-C, SIGTERM (``kill``, ``timeout``, a job scheduler) or SIGHUP (the terminal
         closed) sets ``requested``: the loop checkpoints and stops. A second one aborts without saving."""
         def handler(signum, frame):
-            if signum == signal.SIGHUP:
-                detach_from_terminal()
             if self.requested:
                 raise KeyboardInterrupt
             self.requested = True
-            with contextlib.suppress(OSError):  # a terminal that is gone must not cost the checkpoint
-                tqdm.write(f"\n{STOP_SIGNALS[signum]}: stopping at the next safe point and saving a checkpoint "
-                           "(a second one aborts without saving)")
+            announce_stop(signum, "stopping at the next safe point and saving a checkpoint "
+                                  "(a second one aborts without saving)")
         if threading.current_thread() is not threading.main_thread():
             yield  # a Ray trial runs in a worker thread: its sweep stops it through the stop file
             return
