@@ -24,9 +24,11 @@ import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "benchmarks"))
+sys.path.insert(0, str(ROOT))
 
 from common import emit  # noqa: E402
+
+from rlcore.cpu import cpu_description  # noqa: E402
 
 
 def start(run_dir: Path, steps: int, learning_starts: int, threads: int, seed: int) -> subprocess.Popen:
@@ -79,13 +81,7 @@ def main():
     pair_hours = (2 * steps / min(pair) + steps / one) / 3600
     emit(bench="minitaur_concurrency_5_seeds_1M", one_at_a_time_1_thread_h=round(seeds * steps / one / 3600, 1),
          one_at_a_time_2_threads_h=round(seeds * steps / two_threads / 3600, 1),
-         two_at_a_time_1_thread_each_h=round(pair_hours, 1), cpu=_cpu())
-
-
-def _cpu() -> str:
-    sys.path.insert(0, str(ROOT))
-    from rlcore.cpu import cpu_description
-    return cpu_description()
+         two_at_a_time_1_thread_each_h=round(pair_hours, 1), cpu=cpu_description())
 
 
 if __name__ == "__main__":
