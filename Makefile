@@ -41,7 +41,7 @@ demo: $(CORE)
 
 # The suite on the CPU's cores (pytest-xdist; a test file stays on one worker, so its module fixtures, a
 # local Ray among them, are its own; the longest files first, ranked in tests/conftest.py). On 2 cores of
-# one machine, fresh clones, 2026-11-27: 6 min 08 s on a quick day, 10 min 02 s and 10 min 56 s on a slow
+# one machine, fresh clones, 2026-11-27: 6 min 08 s on a quick day, 10 min 02 s to 10 min 56 s on a slow
 # one (when two test files took twice as long in one process as an hour before).
 test: $(ALL)
 	$(PY) -m pytest -q -n auto --maxprocesses 4 --dist loadfile --no-loadscope-reorder
