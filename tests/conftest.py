@@ -16,6 +16,16 @@ if os.environ.get("PYTEST_XDIST_WORKER_COUNT"):
 
 
 @pytest.fixture
+def sac_without_xla(monkeypatch):
+    """SAC agents built without XLA: ~2 s less CPU for each of the many short-lived agents of the tests
+    of a trainer's bookkeeping (resume, counters, logging). tests/rlcore/test_sac.py and the end-to-end
+    Minitaur run keep the compiled update that training uses."""
+    from rlcore.agents import sac
+
+    monkeypatch.setattr(sac, "XLA", False)
+
+
+@pytest.fixture
 def toy_experiments(monkeypatch):
     """The toy experiments of tests/toy*.py in the registry, so model folders of toy runs load."""
     from rlcore import experiment as registry

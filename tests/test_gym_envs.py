@@ -76,7 +76,7 @@ def test_frozen_lake_dqn_sees_its_cells_one_hot(tmp_path):
     assert policy.make_env().observation_space.shape == (16,)
 
 
-def test_pendulum_sac_rescales_actions(tmp_path):
+def test_pendulum_sac_rescales_actions(tmp_path, sac_without_xla):
     run = api.train("Pendulum-v1", "sac", run_dir=tmp_path / "run", steps=400, learning_starts=200,
                        batch_size=32, actor_hidden=(32, 32), critic_hidden=(32, 32), final_eval_episodes=2,
                        progress=False)

@@ -89,20 +89,20 @@ def test_a_two_seed_sweep_runs_to_the_end_and_its_report_matches_the_run_folders
 
 
 def test_a_sweep_and_its_report_work_on_a_gymnasium_id(local_ray, tmp_path):
-    """Not one of the package's experiments: the trials build the env from its Gymnasium id."""
-    sweep = Sweep("CartPole-v1", "dqn", "gym", str(tmp_path / "gym"), [0, 1], {}, None,
+    """Not one of the package's experiments: the trial builds the env from its Gymnasium id (one seed:
+    a sweep of two is the test above)."""
+    sweep = Sweep("CartPole-v1", "dqn", "gym", str(tmp_path / "gym"), [3], {}, None,
                   {"max_episodes": 5, "checkpoint_every": 5}, 1.0, 0, 2)
     rows = run_sweep(sweep)
-    assert all(r["error"] is None and r["finished"] == 1 for r in rows), rows
-    metas = [json.loads((tmp_path / "gym" / t / "model" / "meta.json").read_text()) for t in ("seed=0", "seed=1")]
-    assert [m["experiment"] for m in metas] == ["CartPole-v1"] * 2 and [m["seed"] for m in metas] == [0, 1]
+    assert [(r["trial"], r["error"], r["finished"]) for r in rows] == [("seed=3", None, 1)], rows
+    meta = json.loads((tmp_path / "gym" / "seed=3" / "model" / "meta.json").read_text())
+    assert (meta["experiment"], meta["seed"]) == ("CartPole-v1", 3)
     result = summarize([tmp_path / "gym"], reps=200)
-    mean = result["sweeps"][0]["aggregates"]["mean"][0]
-    assert mean == pytest.approx(np.mean([m["evaluation"]["mean"] for m in metas]))
+    assert result["sweeps"][0]["aggregates"]["mean"][0] == pytest.approx(meta["evaluation"]["mean"])
 
 
 def test_a_killed_trial_resumes_from_its_checkpoint(local_ray, tmp_path):
-    sweep = _sweep(tmp_path, "kill", seeds=(0,), max_episodes=400, checkpoint_every=5)
+    sweep = _sweep(tmp_path, "kill", seeds=(0,), max_episodes=100, checkpoint_every=5)
     trial = tmp_path / "kill" / "seed=0"
     killed = {}
 
@@ -120,7 +120,7 @@ def test_a_killed_trial_resumes_from_its_checkpoint(local_ray, tmp_path):
     assert len(meta["commands"]) == 2 and meta["commands"][1].endswith("resumed)"), meta["commands"]
     assert int((trial / "worker.pid").read_text()) != killed["pid"]
     episodes = [int(line.split(",")[0]) for line in (trial / "metrics.csv").read_text().splitlines()[1:]]
-    assert episodes == list(range(1, len(episodes) + 1)) and len(episodes) >= 400
+    assert episodes == list(range(1, len(episodes) + 1)) and len(episodes) >= 100
 
 
 def test_ctrl_c_stops_at_a_checkpoint_and_resume_skips_finished_trials(local_ray, tmp_path):

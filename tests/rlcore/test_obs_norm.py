@@ -69,7 +69,7 @@ def register_toy(monkeypatch):
     monkeypatch.setitem(registry.EXPERIMENT_MODULES, "toy_reach", "tests.toy_reach")
 
 
-def test_a_standardized_sac_run_learns_and_its_saved_actor_standardizes(tmp_path):
+def test_a_standardized_sac_run_learns_and_its_saved_actor_standardizes(tmp_path, sac_without_xla):
     from rlcore.evaluation import evaluate
     from rlcore.policies import load_policy
     from rlcore.trainers import sac as sac_trainer
@@ -83,7 +83,7 @@ def test_a_standardized_sac_run_learns_and_its_saved_actor_standardizes(tmp_path
     assert saved.var.numpy().min() < 0.9  # real statistics, not the initial ones (targets in [-0.8, 0.8])
 
 
-def test_a_standardized_run_resumes_with_its_statistics(tmp_path):
+def test_a_standardized_run_resumes_with_its_statistics(tmp_path, sac_without_xla):
     from rlcore.checkpoint import read_checkpoint_state
     from rlcore.trainers import sac as sac_trainer
     from tests.rlcore.test_resume import _interrupt_after

@@ -18,7 +18,7 @@ from rlcore.cpu import cpu_description
 from tests import toy
 from tests.toy import TRAINERS
 
-pytestmark = pytest.mark.usefixtures("toy_experiments")
+pytestmark = pytest.mark.usefixtures("toy_experiments", "sac_without_xla")
 
 
 @pytest.mark.parametrize("algo", ["dqn", "a2c"])
