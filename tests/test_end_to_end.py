@@ -1,6 +1,7 @@
 """The two trainers that otherwise meet their real envs only in multi-hour runs, end to end on the real
 components: Mario PPO on the NES emulator through the process pool (restarts on), killed with -9 and
-resumed; Minitaur SAC on pybullet past learning_starts, stopped and resumed."""
+resumed; Minitaur SAC on pybullet past learning_starts, stopped and resumed. Each through the command
+line; in a process of its own where the test kills it, else in this one (one TensorFlow start-up)."""
 import csv
 import os
 import signal
@@ -15,6 +16,13 @@ from rlcore.checkpoint import read_checkpoint_state
 
 ROOT = Path(__file__).resolve().parents[1]
 QUICK = ["--wandb", "off", "--no-progress", "--final-eval-episodes", "0"]
+
+
+def main(*argv: str) -> int:
+    """The command line in this process (a process of its own only where the test kills it)."""
+    from rlcore import cli
+
+    return cli.main(list(argv))
 
 
 def rows(path: Path) -> list[dict]:
@@ -52,10 +60,7 @@ def test_mario_ppo_through_the_process_pool_survives_kill_9_and_resumes(tmp_path
     assert logged[-1] > state["rollouts"]  # rows past the checkpoint, which the resume drops
 
     budget = state["env_steps"] + 2 * 128
-    resumed = subprocess.run([sys.executable, "main.py", "train", "mario_ppo", "ppo", "--resume", str(run_dir),
-                              "--steps", str(budget), *QUICK], cwd=ROOT, capture_output=True, text=True,
-                             timeout=300)
-    assert resumed.returncode == 0, resumed.stderr[-2000:]
+    assert main("train", "mario_ppo", "ppo", "--resume", str(run_dir), "--steps", str(budget), *QUICK) == 0
     after = [int(r["rollout"]) for r in rows(run_dir / "rollouts.csv")]
     assert after == list(range(1, state["rollouts"] + 3))  # dropped past the checkpoint, then two more
     steps = [int(r["env_steps"]) for r in rows(run_dir / "rollouts.csv")]
@@ -73,18 +78,13 @@ def test_minitaur_sac_on_pybullet_learns_past_learning_starts_and_resumes(tmp_pa
     run_dir = tmp_path / "minitaur"
     small = ["--max-episode-steps", "50", "--learning-starts", "100", "--batch-size", "32",
              "--buffer-size", "5000", "--checkpoint-every", "1"]
-    first = subprocess.run([sys.executable, "main.py", "train", "minitaur", "sac", *small, "--steps", "200",
-                            "--run-dir", str(run_dir), *QUICK], cwd=ROOT, capture_output=True, text=True,
-                           timeout=300)
-    assert first.returncode == 0, first.stderr[-2000:]
+    assert main("train", "minitaur", "sac", *small, "--steps", "200", "--run-dir", str(run_dir), *QUICK) == 0
     metrics = rows(run_dir / "metrics.csv")
     learned = [r for r in metrics if int(r["env_steps"]) > 100]
     assert learned and all(np.isfinite(float(r["critic_loss"])) for r in learned), metrics[-1]
     state = read_checkpoint_state(run_dir / "checkpoint.npz")
     assert state["env_steps"] >= 200 and (run_dir / "replay.npz").is_file()
-    again = subprocess.run([sys.executable, "main.py", "train", "minitaur", "sac", "--resume", str(run_dir),
-                            "--steps", "300", *QUICK], cwd=ROOT, capture_output=True, text=True, timeout=300)
-    assert again.returncode == 0, again.stderr[-2000:]
+    assert main("train", "minitaur", "sac", "--resume", str(run_dir), "--steps", "300", *QUICK) == 0
     final = read_checkpoint_state(run_dir / "checkpoint.npz")
     assert final["env_steps"] >= 300 and len(final["returns"]) > len(state["returns"])
     assert final["commands"][-1].startswith("python main.py train minitaur sac --resume")
