@@ -13,11 +13,6 @@ ROOT = Path(__file__).resolve().parents[1]
 QUICK = ["--wandb", "off", "--no-progress", "--final-eval-episodes", "0"]
 
 
-def main_py(*argv: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "main.py", *argv], cwd=ROOT, capture_output=True, text=True,
-                          timeout=300)
-
-
 def hold_elsewhere(folder: Path) -> subprocess.Popen:
     """Another process that holds the folder's lock until killed."""
     code = ("import sys, time; from rlcore.run_lock import hold_run_folder\n"
@@ -33,18 +28,18 @@ def fingerprint(folder: Path) -> dict:
             for p in sorted(folder.rglob("*")) if p.is_file()}
 
 
-def test_a_second_writer_is_refused_and_a_killed_holder_leaves_no_stale_lock(tmp_path):
+def test_a_second_writer_is_refused_and_a_killed_holder_leaves_no_stale_lock(tmp_path, capfd):
     run_dir = tmp_path / "run"
     from rlcore import cli
 
-    # the runs before and after train in this process; the refused one runs apart, its whole stderr checked
+    # every run in this process (the holder is another): the refused one's whole stderr is checked
     assert cli.main(["train", "cartpole", "dqn", "--episodes", "2", "--run-dir", str(run_dir), *QUICK]) == 0
     holder = hold_elsewhere(run_dir)
     before = fingerprint(run_dir)
     try:
-        second = main_py("train", "cartpole", "dqn", "--resume", str(run_dir), "--episodes", "4", *QUICK)
-        assert second.returncode == 2
-        lines = second.stderr.strip().splitlines()
+        capfd.readouterr()
+        assert cli.main(["train", "cartpole", "dqn", "--resume", str(run_dir), "--episodes", "4", *QUICK]) == 2
+        lines = capfd.readouterr().err.strip().splitlines()
         assert len(lines) == 1 and str(run_dir.resolve()) in lines[0] and str(holder.pid) in lines[0], lines
         assert fingerprint(run_dir) == before  # nothing written, nothing dropped
     finally:
