@@ -1,7 +1,7 @@
 """One interface for run metrics: wandb (online / offline / off), a CSV, and a PNG plot.
 
-wandb mode ``auto`` means online when the user is logged in (``WANDB_API_KEY`` or a netrc entry),
-offline otherwise. Never a prompt; with no network, ``online`` fails fast with one clear line.
+wandb mode ``auto`` follows ``WANDB_MODE`` when the user set it, else means online when the user is
+logged in (``WANDB_API_KEY`` or a netrc entry), offline otherwise. Never a prompt; with no network, ``online`` fails fast with one clear line.
 """
 from __future__ import annotations
 
@@ -29,12 +29,17 @@ def wandb_logged_in() -> bool:
         return False
 
 
+# wandb's own variable, as its users set it (``dryrun`` is its old name for offline)
+WANDB_MODE_ENV = {"online": "online", "offline": "offline", "dryrun": "offline", "disabled": "disabled"}
+
+
 def resolve_wandb_mode(requested: str) -> str:
-    """'auto' -> 'online' if logged in else 'offline'; 'off' -> 'disabled'."""
+    """'auto' -> ``$WANDB_MODE`` if set, else 'online' if logged in, else 'offline'; 'off' -> 'disabled'."""
     if requested not in WANDB_MODES:
         raise UserError(f"unknown wandb mode {requested!r}; choose one of {', '.join(WANDB_MODES)}")
     if requested == "auto":
-        return "online" if wandb_logged_in() else "offline"
+        from_env = WANDB_MODE_ENV.get(os.environ.get("WANDB_MODE", "").strip().lower())
+        return from_env or ("online" if wandb_logged_in() else "offline")
     return "disabled" if requested == "off" else requested
 
 

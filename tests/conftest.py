@@ -4,7 +4,10 @@ import pytest
 
 os.environ.setdefault("TF_CPP_MIN_LOG_LEVEL", "3")
 os.environ.setdefault("WANDB_SILENT", "true")
-os.environ.setdefault("WANDB_MODE", "offline")  # never reach for the network from a test
+# never reach for the network from a test, even where the user is logged in to wandb or set WANDB_MODE
+# (a run's default wandb mode, auto, follows WANDB_MODE); nor read the user's own shipped-model folder
+os.environ["WANDB_MODE"] = "offline"
+os.environ.pop("DEEPRL_MODELS", None)
 # Under `make test` each xdist worker (and the processes its tests start) gets its share of the cores for
 # TensorFlow's op threads, instead of every worker sizing its pools for the whole machine: two workers on
 # 2 cores ran two test files 5-8 % faster so (2026-11-27). Results do not depend on it (the shipped models

@@ -5,7 +5,6 @@ folders. The tests that need no Ray of this module's own are in tests/test_sweep
 import json
 import os
 import signal
-import subprocess
 import threading
 import time
 from pathlib import Path
@@ -17,28 +16,21 @@ from rlcore import experiment as registry
 from rlcore.checkpoint import read_checkpoint_state
 from rlcore.report import load_runs, summarize
 from rlcore.sweep import STOP_FILE, Sweep, run_sweep, start_ray
+from tests.processes import listening, outside_loopback, ray_pids
 
 ROOT = Path(__file__).resolve().parents[1]
 BUDGET = {"max_episodes": 40, "stop_score": 99.0, "checkpoint_every": 10}
 
 
-LOOPBACK = ("127.0.0.1", "[::ffff:127.0.0.1]", "[::1]")
-
-
-def _ray_pids() -> set[str]:
-    out = subprocess.run(["pgrep", "-f", "raylet|gcs_server|ray::"], capture_output=True, text=True).stdout
-    return set(out.split())
-
-
 # Ray processes that were running before these tests started theirs (a developer's own sweep, say):
 # the tests look at their own Ray only
-OTHERS_RAY: set[str] = set()
+OTHERS_RAY: set[int] = set()
 
 
 @pytest.fixture(scope="module")
 def local_ray():
     registry.EXPERIMENT_MODULES["toy"] = "tests.toy"  # trials get the registry from the driver
-    OTHERS_RAY.update(_ray_pids())
+    OTHERS_RAY.update(ray_pids())
     start_ray(None, 2)
     yield
     import ray
@@ -52,9 +44,7 @@ def _sweep(tmp_path, name, seeds=(0, 1), **budget):
 
 
 def _ray_sockets():
-    out = subprocess.run(["ss", "-tnlpH"], capture_output=True, text=True).stdout
-    return [line for line in out.splitlines() if any(p in line for p in ("raylet", "gcs_server", "ray::"))
-            and not any(f"pid={pid}," in line for pid in OTHERS_RAY)]
+    return listening(ray_pids() - OTHERS_RAY)
 
 
 def _wait_for(path, timeout=120):
@@ -67,8 +57,7 @@ def _wait_for(path, timeout=120):
 def test_local_ray_listens_on_loopback_only(local_ray):
     sockets = _ray_sockets()
     assert sockets, "no Ray service found listening"
-    outside = [s for s in sockets if s.split()[3].rsplit(":", 1)[0] not in LOOPBACK]
-    assert not outside, outside
+    assert not outside_loopback(sockets), sockets
 
 
 def test_a_two_seed_sweep_runs_to_the_end_and_its_report_matches_the_run_folders(local_ray, tmp_path):
@@ -186,5 +175,5 @@ def test_no_ray_process_is_left_behind(local_ray):
     while _ray_sockets() and time.monotonic() < deadline:
         time.sleep(0.2)
     assert not _ray_sockets()
-    left = _ray_pids() - OTHERS_RAY
+    left = ray_pids() - OTHERS_RAY
     assert not left, left

@@ -16,7 +16,8 @@ import pytest
 from rlcore.report import aggregates, load_runs, probability_of_improvement, stratified_bootstrap_ci, summarize
 from rlcore.sweep import Sweep, parse_grid, parse_seeds
 from tests.test_cli import run
-from tests.test_sweep import LOOPBACK, ROOT, _sweep, _wait_for
+from tests.processes import group_pids, listening, outside_loopback
+from tests.test_sweep import ROOT, _sweep, _wait_for
 
 
 def test_bootstrap_ci_on_known_answers():
@@ -170,10 +171,8 @@ def test_sigterm_to_the_sweeps_process_group_stops_its_trials_at_a_checkpoint(tm
                             text=True)
     _wait_for(folder / "seed=0" / "checkpoint.npz", timeout=240)
     # the command imports ray.tune (its check for the sweep extra) before it starts Ray: still loopback only
-    group = set(subprocess.run(["pgrep", "-g", str(proc.pid)], capture_output=True, text=True).stdout.split())
-    sockets = [s for s in subprocess.run(["ss", "-tnlpH"], capture_output=True, text=True).stdout.splitlines()
-               if any(f"pid={pid}," in s for pid in group)]
-    outside = [s for s in sockets if s.split()[3].rsplit(":", 1)[0] not in LOOPBACK]
+    sockets = listening(group_pids(proc.pid))
+    outside = outside_loopback(sockets)
     os.killpg(proc.pid, signal.SIGTERM)
     out, err = proc.communicate(timeout=180)
     assert proc.returncode == 130, err[-2000:]

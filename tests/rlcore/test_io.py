@@ -91,12 +91,19 @@ def test_hyperparameters_override_and_round_trip():
 
 def test_wandb_modes(monkeypatch, tmp_path):
     monkeypatch.delenv("WANDB_API_KEY", raising=False)
+    monkeypatch.delenv("WANDB_MODE", raising=False)  # the tests' own (tests/conftest.py)
     monkeypatch.setenv("NETRC", str(tmp_path / "no-netrc"))
     monkeypatch.setenv("HOME", str(tmp_path))
     assert resolve_wandb_mode("auto") == "offline"
     assert resolve_wandb_mode("off") == "disabled"
     monkeypatch.setenv("WANDB_API_KEY", "x" * 40)
     assert resolve_wandb_mode("auto") == "online"
+    # wandb's own variable, where the user set it, decides for auto (not for a mode asked for by name)
+    for value, mode in (("offline", "offline"), ("disabled", "disabled"), ("dryrun", "offline"), ("", "online")):
+        monkeypatch.setenv("WANDB_MODE", value)
+        assert resolve_wandb_mode("auto") == mode, value
+    monkeypatch.setenv("WANDB_MODE", "offline")
+    assert resolve_wandb_mode("online") == "online"
     with pytest.raises(UserError):
         resolve_wandb_mode("cloud")
 
