@@ -205,3 +205,17 @@ def test_status_of_a_sweep_folder_is_a_line_per_trial(tmp_path, capsys):
         "  seed=1: checkpoint at 700 env steps, 2.0 h; last evaluation at env step 500: mean 3.25 +- 0.50, "
         "40% of its episodes to the time limit",
         "  seed=2: not started"]
+
+
+def test_tune_warns_of_no_slow_report_even_when_imported_before_the_sweep(monkeypatch):
+    """The sweep command imports ray.tune (its check for the sweep extra) before run_sweep sets Tune's
+    threshold for "may be a performance bottleneck" lines: the threshold Tune derived then is set too."""
+    from ray.tune.utils import util
+
+    from rlcore.sweep import quiet_tune
+
+    monkeypatch.setattr(util.warn_if_slow, "DEFAULT_THRESHOLD", 0.5)  # as Tune reads it without the variable
+    monkeypatch.setenv("TUNE_WARN_THRESHOLD_S", "")
+    monkeypatch.delenv("TUNE_WARN_THRESHOLD_S")
+    quiet_tune()
+    assert util.warn_if_slow("process_trial_result").threshold == 600
