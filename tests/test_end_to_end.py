@@ -76,8 +76,10 @@ def test_mario_ppo_through_the_process_pool_survives_kill_9_and_resumes(tmp_path
 
 def test_minitaur_sac_on_pybullet_learns_past_learning_starts_and_resumes(tmp_path):
     run_dir = tmp_path / "minitaur"
-    small = ["--max-episode-steps", "50", "--learning-starts", "100", "--batch-size", "32",
-             "--buffer-size", "5000", "--checkpoint-every", "1"]
+    # small, and one gradient step per compiled call: the preset's four took 31 s of CPU for the test against
+    # 16 s, most of it compiling them in each of the two runs (stacked updates: tests/rlcore/test_sac.py)
+    small = ["--max-episode-steps", "50", "--learning-starts", "100", "--batch-size", "32", "--buffer-size", "5000",
+             "--updates-per-call", "1", "--checkpoint-every", "1"]
     assert main("train", "minitaur", "sac", *small, "--steps", "200", "--run-dir", str(run_dir), *QUICK) == 0
     metrics = rows(run_dir / "metrics.csv")
     learned = [r for r in metrics if int(r["env_steps"]) > 100]
