@@ -250,8 +250,11 @@ def start_ray(address: str | None, num_cpus: int | None) -> bool:
         return True
     from rlcore.quiet import filtered_stderr
     with filtered_stderr(), ignoring_stop_signals():
-        ray.init(num_cpus=num_cpus or os.cpu_count(), include_dashboard=False, _node_ip_address="127.0.0.1",
-                 runtime_env=runtime_env, log_to_driver=False, configure_logging=False)
+        # "local": a new instance of our own, even where RAY_ADDRESS is set or a `ray start` cluster runs
+        # (without it Ray joins that, and refuses the CPU count: "When connecting to an existing cluster...")
+        ray.init(address="local", num_cpus=num_cpus or os.cpu_count(), include_dashboard=False,
+                 _node_ip_address="127.0.0.1", runtime_env=runtime_env, log_to_driver=False,
+                 configure_logging=False)
     return True
 
 

@@ -29,9 +29,19 @@ OTHERS_RAY: set[int] = set()
 
 @pytest.fixture(scope="module")
 def local_ray():
+    """A local Ray of this module's own, started while RAY_ADDRESS names a cluster (as on a machine where
+    the user works with one): a sweep without --address still starts its own."""
     registry.EXPERIMENT_MODULES["toy"] = "tests.toy"  # trials get the registry from the driver
     OTHERS_RAY.update(ray_pids())
-    start_ray(None, 2)
+    before = os.environ.get("RAY_ADDRESS")
+    os.environ["RAY_ADDRESS"] = "127.0.0.1:1"  # nothing listens there
+    try:
+        start_ray(None, 2)
+    finally:
+        if before is None:
+            del os.environ["RAY_ADDRESS"]
+        else:
+            os.environ["RAY_ADDRESS"] = before
     yield
     import ray
     ray.shutdown()
