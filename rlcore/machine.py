@@ -4,11 +4,13 @@ A seed repeats a run or an evaluation bit for bit only on the same CPU family an
 TensorFlow's oneDNN kernels order float sums by the CPU's vector units, so on another CPU a greedy
 argmax or a sampled action can flip and an episode take another course (seen: the shipped Minitaur
 model's first episodes returned 22.86 on an Intel Xeon with AMX against 22.48 recorded on an AMD
-EPYC). A record is replayed exactly only where :func:`replays_exactly` says so; elsewhere callers
-check what holds on every machine (a bar, a statistical bound).
+EPYC). The same holds for one CPU with oneDNN turned off (``TF_ENABLE_ONEDNN_OPTS=0``: 22.82 here
+against 22.48 with it on, 2026-11-27). A record is replayed exactly only where :func:`replays_exactly`
+says so; elsewhere callers check what holds on every machine (a bar, a statistical bound).
 """
 from __future__ import annotations
 
+import os
 import platform
 
 from rlcore.cpu import cpu_description
@@ -31,9 +33,21 @@ def package_versions() -> dict:
     return found
 
 
+# the settings a record made without saying (every one before 2026-11-27) was made with: TensorFlow's
+# defaults on x86-64 Linux
+DEFAULT_SETTINGS = {"onednn": True}
+
+
+def numeric_settings() -> dict:
+    """This process's environment settings that change TensorFlow's numbers on one CPU: whether its
+    oneDNN kernels are on (``TF_ENABLE_ONEDNN_OPTS``, read as TensorFlow reads it)."""
+    onednn = os.environ.get("TF_ENABLE_ONEDNN_OPTS", "1").strip().lower() not in ("0", "false")
+    return {"onednn": onednn}
+
+
 def this_machine() -> dict:
-    """``{"cpu": ..., "versions": {...}}`` of this process, as meta.json records them."""
-    return {"cpu": cpu_description(), "versions": package_versions()}
+    """``{"cpu": ..., "versions": {...}, "settings": {...}}`` of this process, as meta.json records them."""
+    return {"cpu": cpu_description(), "versions": package_versions(), "settings": numeric_settings()}
 
 
 def recorded_machine(meta: dict) -> dict | None:
@@ -50,12 +64,15 @@ def recorded_machine(meta: dict) -> dict | None:
 
 def replays_exactly(recorded: dict | None, here: dict | None = None) -> bool:
     """Whether a record made on ``recorded`` can be expected to repeat bit for bit on ``here`` (default
-    this machine): the same CPU description (name and vector units) and every recorded package at the
-    same version. Unknown is no."""
+    this machine): the same CPU description (name and vector units), the same numeric settings (a record
+    without them was made with the defaults) and every recorded package at the same version. Unknown
+    is no."""
     if not recorded:
         return False
     here = this_machine() if here is None else here
     if recorded.get("cpu") != here.get("cpu"):
+        return False
+    if recorded.get("settings", DEFAULT_SETTINGS) != here.get("settings", DEFAULT_SETTINGS):
         return False
     versions = here.get("versions", {})
     return all(versions.get(name) == value for name, value in recorded.get("versions", {}).items())

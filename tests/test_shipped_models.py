@@ -142,6 +142,9 @@ def test_a_record_replays_exactly_only_on_its_own_cpu_and_versions():
     assert not machine.replays_exactly({**here, "cpu": "Intel(R) Xeon(R) (avx2 fma avx512f amx_tile)"}, here)
     assert not machine.replays_exactly({**here, "versions": {"tensorflow": "2.20.0"}}, here)
     assert not machine.replays_exactly(None, here)  # a record that does not say where it was made
+    # oneDNN off changes the numbers on one CPU too; a record without settings was made with the defaults
+    assert not machine.replays_exactly(here, {**here, "settings": {"onednn": False}})
+    assert machine.replays_exactly(here, {**here, "settings": {"onednn": True}})
     # the evaluation's own machine wins over the training run's
     meta = {"cpu": "A", "versions": {}, "evaluation": {"machine": {"cpu": "B", "versions": {}}}}
     assert machine.recorded_machine(meta)["cpu"] == "B"
@@ -156,3 +159,13 @@ def test_render_of_a_shipped_model_is_a_decodable_mp4(tmp_path):
     assert len(frames) == result["frames"] > 10
     assert frames.shape[1:] == (400, 600, 3)
     assert iio.immeta(out)["fps"] == pytest.approx(30)
+
+
+def test_turning_onednn_off_is_part_of_what_a_record_replays_on(monkeypatch):
+    monkeypatch.delenv("TF_ENABLE_ONEDNN_OPTS", raising=False)
+    assert machine.this_machine()["settings"] == {"onednn": True}
+    for off in ("0", "false", "False"):
+        monkeypatch.setenv("TF_ENABLE_ONEDNN_OPTS", off)
+        assert machine.this_machine()["settings"] == {"onednn": False}
+    recorded = {**machine.this_machine(), "settings": {"onednn": True}}
+    assert not machine.replays_exactly(recorded)  # here oneDNN is off: the bar path, not the replay
