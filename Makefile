@@ -40,9 +40,11 @@ demo: $(CORE)
 	$(PY) main.py train lunar_lander dqn --video
 
 # The suite on the CPU's cores (pytest-xdist; a test file stays on one worker, so its module fixtures, a
-# local Ray among them, are its own; the longest files first, ranked in tests/conftest.py). On 2 cores of
-# one machine, fresh clones, 2026-11-27: 6 min 08 s on a quick day, 10 min 02 s to 10 min 56 s on a slow
-# one (when two test files took twice as long in one process as an hour before).
+# local Ray among them, are its own; the longest files first, ranked in tests/conftest.py). It is
+# CPU-bound, and the machine's speed moves by up to 2x from hour to hour. On 2 cores of one machine, fresh
+# clones, quiet, 2026-11-27, the suite before and after it was made to do ~20 % less, side by side:
+# 9 min 34 s -> 7 min 57 s and 8 min 04 s at 11:00; 7 min 36 s -> 5 min 59 s at 12:15 (the old suite took
+# up to 10 min 56 s earlier that day). Three workers on 2 cores were slower (8 min 18 s).
 test: $(ALL)
 	$(PY) -m pytest -q -n auto --maxprocesses 4 --dist loadfile --no-loadscope-reorder
 
