@@ -120,6 +120,8 @@ class StopRequest:
         closed) sets ``requested``: the loop checkpoints and stops. A second one aborts without saving."""
         def handler(signum, frame):
             if self.requested:
+                if signum == signal.SIGHUP:
+                    detach_from_terminal()  # the abort's own line must not fail on a terminal that is gone
                 raise KeyboardInterrupt
             self.requested = True
             announce_stop(signum, "stopping at the next safe point and saving a checkpoint "
