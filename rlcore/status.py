@@ -13,6 +13,7 @@ finished. TensorFlow-free.
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import pandas as pd
@@ -189,7 +190,7 @@ def sweep_status(folder: str | Path) -> list[str]:
             final = final_metrics(json.loads(meta.read_text()))  # as the sweep reports it (Mario: flag share)
             lines.append(f"  {name}: finished at {final['env_steps']:,} env steps"
                          + (f", final score {final['final_score']:.2f} on unseen seeds"
-                            if final["final_score"] == final["final_score"] else ""))  # NaN: not evaluated
+                            if not math.isnan(final["final_score"]) else ""))  # NaN: not evaluated
         elif (trial / CHECKPOINT_FILE).is_file():
             state = read_checkpoint_state(trial / CHECKPOINT_FILE)
             last = evaluation_lines(trial / "evals.csv", last=1)

@@ -1,7 +1,8 @@
 """One interface for run metrics: wandb (online / offline / off), a CSV, and a PNG plot.
 
 wandb mode ``auto`` follows ``WANDB_MODE`` when the user set it, else means online when the user is
-logged in (``WANDB_API_KEY`` or a netrc entry), offline otherwise. Never a prompt; with no network, ``online`` fails fast with one clear line.
+logged in (``WANDB_API_KEY`` or a netrc entry), offline otherwise. Never a prompt; with no network,
+``online`` fails fast with one clear line.
 """
 from __future__ import annotations
 
