@@ -13,16 +13,10 @@ from pathlib import Path
 import numpy as np
 
 from rlcore.checkpoint import read_checkpoint_state
+from tests.test_cli import run  # the command line in this process
 
 ROOT = Path(__file__).resolve().parents[1]
 QUICK = ["--wandb", "off", "--no-progress", "--final-eval-episodes", "0"]
-
-
-def main(*argv: str) -> int:
-    """The command line in this process (a process of its own only where the test kills it)."""
-    from rlcore import cli
-
-    return cli.main(list(argv))
 
 
 def rows(path: Path) -> list[dict]:
@@ -37,7 +31,7 @@ def route_keys(checkpoint: Path) -> set[str]:
         return {name for name in data.files if name.startswith("array/env/")}
 
 
-def test_mario_ppo_through_the_process_pool_survives_kill_9_and_resumes(tmp_path):
+def test_mario_ppo_through_the_process_pool_survives_kill_9_and_resumes(tmp_path, capsys):
     run_dir = tmp_path / "mario"
     argv = ["train", "mario_ppo", "ppo", "--preset", "levels", "--num-envs", "2", "--vec", "processes",
             "--n-steps", "64", "--epochs", "1", "--minibatch", "64", "--checkpoint-rollouts", "2",
@@ -60,7 +54,7 @@ def test_mario_ppo_through_the_process_pool_survives_kill_9_and_resumes(tmp_path
     assert logged[-1] > state["rollouts"]  # rows past the checkpoint, which the resume drops
 
     budget = state["env_steps"] + 2 * 128
-    assert main("train", "mario_ppo", "ppo", "--resume", str(run_dir), "--steps", str(budget), *QUICK) == 0
+    assert run(capsys, "train", "mario_ppo", "ppo", "--resume", str(run_dir), "--steps", str(budget), *QUICK)[0] == 0
     after = [int(r["rollout"]) for r in rows(run_dir / "rollouts.csv")]
     assert after == list(range(1, state["rollouts"] + 3))  # dropped past the checkpoint, then two more
     steps = [int(r["env_steps"]) for r in rows(run_dir / "rollouts.csv")]
@@ -74,19 +68,19 @@ def test_mario_ppo_through_the_process_pool_survives_kill_9_and_resumes(tmp_path
         {name.split("/")[3] for name in routes}
 
 
-def test_minitaur_sac_on_pybullet_learns_past_learning_starts_and_resumes(tmp_path):
+def test_minitaur_sac_on_pybullet_learns_past_learning_starts_and_resumes(tmp_path, capsys):
     run_dir = tmp_path / "minitaur"
     # small, and one gradient step per compiled call: the preset's four took 31 s of CPU for the test against
     # 16 s, most of it compiling them in each of the two runs (stacked updates: tests/rlcore/test_sac.py)
     small = ["--max-episode-steps", "50", "--learning-starts", "100", "--batch-size", "32", "--buffer-size", "5000",
              "--updates-per-call", "1", "--checkpoint-every", "1"]
-    assert main("train", "minitaur", "sac", *small, "--steps", "200", "--run-dir", str(run_dir), *QUICK) == 0
+    assert run(capsys, "train", "minitaur", "sac", *small, "--steps", "200", "--run-dir", str(run_dir), *QUICK)[0] == 0
     metrics = rows(run_dir / "metrics.csv")
     learned = [r for r in metrics if int(r["env_steps"]) > 100]
     assert learned and all(np.isfinite(float(r["critic_loss"])) for r in learned), metrics[-1]
     state = read_checkpoint_state(run_dir / "checkpoint.npz")
     assert state["env_steps"] >= 200 and (run_dir / "replay.npz").is_file()
-    assert main("train", "minitaur", "sac", "--resume", str(run_dir), "--steps", "300", *QUICK) == 0
+    assert run(capsys, "train", "minitaur", "sac", "--resume", str(run_dir), "--steps", "300", *QUICK)[0] == 0
     final = read_checkpoint_state(run_dir / "checkpoint.npz")
     assert final["env_steps"] >= 300 and len(final["returns"]) > len(state["returns"])
     assert final["commands"][-1].startswith("python main.py train minitaur sac --resume")

@@ -10,6 +10,7 @@ from pathlib import Path
 import pytest
 
 from rlcore.errors import WriteFailed
+from tests.test_cli import run  # in this process; capfd reads what it wrote to the stderr descriptor
 
 QUICK = ["--wandb", "off", "--no-progress", "--final-eval-episodes", "0"]
 
@@ -43,52 +44,41 @@ def fill(disk: Path, leave: int) -> Path:
     return filler
 
 
-def run(*argv: str, capfd=None) -> tuple[int, list[str]]:
-    """A command run as ``main.py`` runs it, in this process (one TensorFlow start-up for the file; what
-    a separate process adds, TensorFlow's own start-up lines, is tested in test_bad_values.py), with
-    the lines it wrote to the standard error file descriptor when ``capfd`` is given."""
-    from rlcore import cli
-
-    if capfd is not None:
-        capfd.readouterr()
-    code = cli.main(list(argv))
-    return code, capfd.readouterr().err.strip().splitlines() if capfd is not None else []
-
-
 def test_a_full_disk_is_one_line_and_the_last_checkpoint_resumes(small_disk, capfd):
     """Full at a checkpoint (64 kB left: the rows fit, the Q-networks, Adam and replay do not), then full
     at the first CSV row (nothing left): each is one line, and the run resumes once there is room."""
     run_dir = small_disk / "run"
-    assert run("train", "cartpole", "dqn", "--episodes", "3", "--checkpoint-every", "1",
+    assert run(capfd, "train", "cartpole", "dqn", "--episodes", "3", "--checkpoint-every", "1",
                "--run-dir", str(run_dir), *QUICK)[0] == 0
     good = (run_dir / "checkpoint.npz").read_bytes()
     for leave in (64_000, 0):
         filler = fill(small_disk, leave)
-        code, lines = run("train", "cartpole", "dqn", "--resume", str(run_dir), "--episodes", "40", *QUICK,
-                          capfd=capfd)
+        code, _, err = run(capfd, "train", "cartpole", "dqn", "--resume", str(run_dir), "--episodes", "40", *QUICK)
+        lines = err.strip().splitlines()
         assert code == 2 and len(lines) == 1 and lines[0].startswith(f"error: cannot write {run_dir}/"), (leave, lines)
         assert "No space left on device" in lines[0] and "free some space" in lines[0]
         assert not [p for p in run_dir.rglob("*") if ".tmp" in p.name], "a temporary file was left behind"
         assert (run_dir / "checkpoint.npz").read_bytes() == good
         filler.unlink()
-    assert run("train", "cartpole", "dqn", "--resume", str(run_dir), "--episodes", "5", *QUICK)[0] == 0
+    assert run(capfd, "train", "cartpole", "dqn", "--resume", str(run_dir), "--episodes", "5", *QUICK)[0] == 0
 
 
 def test_a_read_only_disk_is_one_clear_error_and_the_run_resumes_once_writable(small_disk, capfd):
     run_dir = small_disk / "run"
-    assert run("train", "cartpole", "dqn", "--episodes", "2", "--run-dir", str(run_dir), *QUICK)[0] == 0
+    assert run(capfd, "train", "cartpole", "dqn", "--episodes", "2", "--run-dir", str(run_dir), *QUICK)[0] == 0
     subprocess.run(["mount", "-o", "remount,ro", str(small_disk)], check=True)
     try:
-        code, lines = run("train", "cartpole", "dqn", "--resume", str(run_dir), "--episodes", "4", *QUICK,
-                          capfd=capfd)
+        code, _, err = run(capfd, "train", "cartpole", "dqn", "--resume", str(run_dir), "--episodes", "4", *QUICK)
+        lines = err.strip().splitlines()
         assert code == 2 and len(lines) == 1, lines
         assert str(run_dir) in lines[0] and "Read-only file system" in lines[0]
-        code, lines = run("render", "cartpole", "dqn", "--model", str(run_dir / "model"),
-                          "--out", str(small_disk / "video.mp4"), capfd=capfd)
+        code, _, err = run(capfd, "render", "cartpole", "dqn", "--model", str(run_dir / "model"),
+                           "--out", str(small_disk / "video.mp4"))
+        lines = err.strip().splitlines()
         assert code == 2 and len(lines) == 1 and "--out" in lines[0] and "Read-only" in lines[0], lines
     finally:
         subprocess.run(["mount", "-o", "remount,rw", str(small_disk)], check=True)
-    assert run("train", "cartpole", "dqn", "--resume", str(run_dir), "--episodes", "4", *QUICK)[0] == 0
+    assert run(capfd, "train", "cartpole", "dqn", "--resume", str(run_dir), "--episodes", "4", *QUICK)[0] == 0
 
 
 def test_write_failed_names_the_path_and_what_to_do(tmp_path):

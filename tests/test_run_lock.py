@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 from rlcore.run_lock import RunFolderBusy, hold_run_folder
+from tests.test_cli import run
 
 ROOT = Path(__file__).resolve().parents[1]
 QUICK = ["--wandb", "off", "--no-progress", "--final-eval-episodes", "0"]
@@ -30,22 +31,20 @@ def fingerprint(folder: Path) -> dict:
 
 def test_a_second_writer_is_refused_and_a_killed_holder_leaves_no_stale_lock(tmp_path, capfd):
     run_dir = tmp_path / "run"
-    from rlcore import cli
-
     # every run in this process (the holder is another): the refused one's whole stderr is checked
-    assert cli.main(["train", "cartpole", "dqn", "--episodes", "2", "--run-dir", str(run_dir), *QUICK]) == 0
+    assert run(capfd, "train", "cartpole", "dqn", "--episodes", "2", "--run-dir", str(run_dir), *QUICK)[0] == 0
     holder = hold_elsewhere(run_dir)
     before = fingerprint(run_dir)
     try:
-        capfd.readouterr()
-        assert cli.main(["train", "cartpole", "dqn", "--resume", str(run_dir), "--episodes", "4", *QUICK]) == 2
-        lines = capfd.readouterr().err.strip().splitlines()
+        code, _, err = run(capfd, "train", "cartpole", "dqn", "--resume", str(run_dir), "--episodes", "4", *QUICK)
+        assert code == 2
+        lines = err.strip().splitlines()
         assert len(lines) == 1 and str(run_dir.resolve()) in lines[0] and str(holder.pid) in lines[0], lines
         assert fingerprint(run_dir) == before  # nothing written, nothing dropped
     finally:
         holder.send_signal(signal.SIGKILL)
         holder.wait()
-    assert cli.main(["train", "cartpole", "dqn", "--resume", str(run_dir), "--episodes", "4", *QUICK]) == 0
+    assert run(capfd, "train", "cartpole", "dqn", "--resume", str(run_dir), "--episodes", "4", *QUICK)[0] == 0
 
 
 def test_a_process_may_reenter_its_own_lock_and_another_may_not(tmp_path):

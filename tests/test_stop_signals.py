@@ -58,7 +58,7 @@ def group_is_gone(pgid: int, timeout: float = 15) -> bool:
 
 
 @pytest.mark.parametrize("number", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
-def test_a_signal_to_the_process_group_checkpoints_a_process_pool_run(number, tmp_path):
+def test_a_signal_to_the_process_group_checkpoints_a_process_pool_run(number, tmp_path, capsys):
     run_dir = tmp_path / "run"
     proc = start([*MARIO, "--steps", "100000", "--run-dir", str(run_dir)])
     wait_for_rollouts(proc, run_dir, 2)
@@ -75,10 +75,10 @@ def test_a_signal_to_the_process_group_checkpoints_a_process_pool_run(number, tm
         return
     # and the plain resume continues from it: the next rollout is the one after
     env_steps = state["env_steps"]
-    from rlcore import cli  # in this process: nothing signals it
+    from tests.test_cli import run  # in this process: nothing signals it
 
-    assert cli.main(["train", "mario_ppo", "ppo", "--resume", str(run_dir), "--steps", str(env_steps + 128),
-                     "--no-progress", "--wandb", "off", "--final-eval-episodes", "0"]) == 0
+    assert run(capsys, "train", "mario_ppo", "ppo", "--resume", str(run_dir), "--steps", str(env_steps + 128),
+               "--no-progress", "--wandb", "off", "--final-eval-episodes", "0")[0] == 0
     after = rollouts_logged(run_dir)
     assert after[:len(logged)] == logged and after[len(logged):] == [logged[-1] + 1, logged[-1] + 2]
 
