@@ -287,7 +287,7 @@ def cmd_sweep(args) -> int:
 
 def cmd_report(args) -> int:
     from rlcore.extras import require
-    from rlcore.report import keep, markdown, plot_curves, summarize
+    from rlcore.report import keep, markdown, plot_curves, plot_evals, summarize
 
     require("rliable.metrics", "The report command")  # the sweep extra, or one line saying so
     folders = [Path(d) for d in args.sweep_dirs]
@@ -302,8 +302,8 @@ def cmd_report(args) -> int:
     first = folders[0]
     from rlcore.atomic import write_atomic
     write_atomic(first / "report.md", lambda p: p.write_text(text + "\n"))
-    png = plot_curves(result, first / "report_curves.png")
-    print(f"written: {first / 'report.md'}, {png}")
+    pngs = [plot_curves(result, first / "report_curves.png"), plot_evals(result, first / "report_evals.png")]
+    print(f"written: {first / 'report.md'}, {', '.join(str(p) for p in pngs if p)}")
     return 0
 
 

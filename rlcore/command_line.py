@@ -178,10 +178,12 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
                        help="join a running Ray cluster (e.g. 10.0.0.5:6379) instead of starting local Ray")
     sweep.add_argument("--resume", action="store_true", help="continue the sweep NAME; finished trials are kept")
     report = sub.add_parser("report", help="results of sweeps: per run, and mean / median / IQM with 95%% CIs",
-                            description="Per run: the final evaluation on unseen seeds, env steps, wall time. "
+                            description="Per run: the final evaluation on unseen seeds, env steps, wall time, "
+                                        "and what its periodic evaluations saw (collapses, the weights kept). "
                                         "Over runs: mean, median and IQM with 95%% stratified bootstrap CIs "
                                         "(rliable's method); with two sweeps, P(first beats second). Writes "
-                                        "report.md and report_curves.png into the first sweep folder.")
+                                        "report.md, report_curves.png and, where runs evaluated periodically, "
+                                        "report_evals.png into the first sweep folder.")
     report.add_argument("sweep_dirs", nargs="+", metavar="SWEEP_DIR")
     report.add_argument("--reps", type=whole_number(Allowed(low=100, high=10**6)), default=5000, help="bootstrap resamples")
     report.add_argument("--keep", metavar="DIR", default=None,

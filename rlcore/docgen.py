@@ -204,6 +204,12 @@ def region_sweeps(page: str, experiment: str) -> str:
                   "median [95% CI]"], rows)
 
 
+def region_sweep_stability(page: str, experiment: str) -> str:
+    """Each kept sweep's seeds through training: collapses of the periodic evaluations, the weights kept."""
+    from rlcore.docgen_sweeps import sweep_stability
+    return sweep_stability(page, experiment)
+
+
 def region_curves(page: str, experiment: str) -> str:
     """The training curves of the shipped models (and the sweeps' IQM curves), as images."""
     parts = []
@@ -217,6 +223,10 @@ def region_curves(page: str, experiment: str) -> str:
         if m.sweep and (REPO / m.sweep.folder / "report_curves.png").is_file():
             parts.append(f"**{m.name}, {len(m.sweep.seeds)} seeds (IQM of the 100-episode average, 95% CI band)**"
                          f"\n\n![{m.name} sweep]({link(page, m.sweep.folder + '/report_curves.png')}){{ width=\"60%\" }}")
+        if m.sweep and (REPO / m.sweep.folder / "report_evals.png").is_file():
+            parts.append(f"**{m.name}, {len(m.sweep.seeds)} seeds: periodic evaluations on selection seeds (IQM, 95% CI "
+                         f"band; each seed thin)**\n\n![{m.name} sweep evaluations]"
+                         f"({link(page, m.sweep.folder + '/report_evals.png')}){{ width=\"60%\" }}")
     return "\n\n".join(parts) or "*No curves shipped.*"
 
 
@@ -279,7 +289,7 @@ def region_seed_ranges(page: str, arg: str) -> str:
 
 
 REGIONS = {"results-table": region_results_table, "gif-strip": region_gif_strip, "shipped": region_shipped,
-           "sweeps": region_sweeps, "curves": region_curves, "csv-columns": region_csv_columns,
+           "sweeps": region_sweeps, "sweep-stability": region_sweep_stability, "curves": region_curves, "csv-columns": region_csv_columns,
            "meta-keys": region_meta_keys, "bars": region_bars,
            "seed-ranges": region_seed_ranges, "presets": region_presets}
 _REGION = re.compile(r"(<!-- generated:([\w-]+)(?: ([\w./-]+))? -->\n)(.*?)(<!-- /generated -->)", re.S)

@@ -21,6 +21,7 @@ import numpy as np
 
 from rlcore.atomic import write_atomic
 from rlcore.errors import UserError
+from rlcore.eval_history import stability_summary, story, story_text
 from rlcore.extras import require
 
 AGGREGATES = ("mean", "median", "iqm")
@@ -84,7 +85,8 @@ def load_runs(sweep_dir: Path) -> list[dict]:
         rows.append({"trial": meta_path.parent.parent.name, "seed": meta["seed"], "score": float(score),
                      "eval_episodes": ev.get("episodes"), "env_steps": meta["env_steps"],
                      "wall_seconds": meta["wall_seconds"], "run_dir": meta_path.parent.parent,
-                     "cpu": meta.get("cpu"),
+                     "cpu": meta.get("cpu"), "time_limit_share": ev.get("time_limit_share"),
+                     "story": story(meta_path.parent.parent, meta),
                      "what": f"{meta.get('experiment')} {meta.get('algo')}"})
     if not rows:
         raise UserError(f"{sweep_dir} holds no finished, evaluated run (model/meta.json with an evaluation)")
@@ -163,19 +165,23 @@ def summarize(sweep_dirs: list[Path], reps: int = 5000) -> dict:
     return result
 
 
+def share_text(share: float | None) -> str:
+    return "–" if share is None else f"{share:.0%}"
+
+
 def markdown(result: dict) -> str:
     lines = []
     for s in result["sweeps"]:
         lines += [f"## {s['label']} ({s['folder']})", "",
-                  "| run | seed | final score (unseen seeds) | env steps | wall | env steps/s | CPU |",
-                  "| --- | ---: | ---: | ---: | ---: | ---: | --- |"]
-        lines += [f"| {r['trial']} | {r['seed']} | {r['score']:.3f} | {r['env_steps']:,} "
-                  f"| {r['wall_seconds']:.0f} s | {r['env_steps'] / max(r['wall_seconds'], 1e-9):,.0f} "
+                  "| run | seed | final score (unseen seeds) | to time limit | env steps | wall | env steps/s | CPU |",
+                  "| --- | ---: | ---: | ---: | ---: | ---: | ---: | --- |"]
+        lines += [f"| {r['trial']} | {r['seed']} | {r['score']:.3f} | {share_text(r.get('time_limit_share'))} "
+                  f"| {r['env_steps']:,} | {r['wall_seconds']:.0f} s | {r['env_steps'] / max(r['wall_seconds'], 1e-9):,.0f} "
                   f"| {r.get('cpu') or 'not recorded'} |" for r in s["runs"]]
         lines += ["", f"| over {len(s['runs'])} runs | point | 95% CI (stratified bootstrap) |",
                   "| --- | ---: | --- |"]
         lines += [f"| {name} | {p:.3f} | [{lo:.3f}, {hi:.3f}] |" for name, (p, lo, hi) in s["aggregates"].items()]
-        lines.append("")
+        lines += ["", *stability_lines(s["runs"]), ""]
     if "probability_of_improvement" in result:
         p, lo, hi = result["probability_of_improvement"]
         first, second = (s["label"] for s in result["sweeps"])
@@ -183,38 +189,92 @@ def markdown(result: dict) -> str:
     return "\n".join(lines)
 
 
+def stability_lines(runs: list[dict]) -> list[str]:
+    """What the runs' periodic evaluations (on selection seeds) say: collapses and the weights kept
+    (:mod:`rlcore.eval_history` defines a collapse)."""
+    stories = [r["story"] for r in runs]
+    if not any(st.evaluations for st in stories):
+        return ["No periodic evaluations: each model holds its run's last weights."]
+    lines = [f"Periodic evaluations (selection seeds): {stability_summary(stories)}", ""]
+    lines += [f"- {r['trial']}: {story_text(r['story'])}" for r in runs]
+    return lines
+
+
+def _iqm_band(curves: np.ndarray, reps: int) -> tuple[list, list, list]:
+    """IQM over runs at each column of a [runs, points] matrix, with its 95 % bootstrap interval."""
+    metrics = require("rliable.metrics", "A sweep report")  # the sweep extra
+    iqm, low, high = [], [], []
+    for j in range(curves.shape[1]):
+        point, ci = stratified_bootstrap_ci(metrics.aggregate_iqm, curves[:, j:j + 1], reps=reps)
+        iqm.append(float(point))
+        low.append(float(ci[0]))
+        high.append(float(ci[1]))
+    return iqm, low, high
+
+
+def _save_figure(fig, ax, ylabel: str, out: Path) -> Path:
+    import matplotlib.pyplot as plt
+
+    from rlcore.atomic import atomic_path
+
+    ax.set_xlabel("env steps")
+    ax.set_ylabel(ylabel)
+    ax.legend()
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    out = Path(out)
+    with atomic_path(out) as tmp:
+        fig.savefig(tmp, dpi=110)
+    plt.close(fig)
+    return out
+
+
+def _figure():
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt.subplots(figsize=(8, 4.5))
+
+
 def plot_curves(result: dict, out: Path, reps: int = 1000) -> Path:
     """IQM of the 100-episode average return over env steps, with its 95 % CI band, per sweep.
 
     The band covers the env steps every run reached; each run is also drawn in full, thin.
     """
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    metrics = require("rliable.metrics", "A sweep report")  # the sweep extra
-
-    fig, ax = plt.subplots(figsize=(8, 4.5))
+    fig, ax = _figure()
     for s in result["sweeps"]:
         grid, curves = learning_curve([r["run_dir"] for r in s["runs"]])
-        iqm, low, high = [], [], []
-        for j in range(len(grid)):
-            point, ci = stratified_bootstrap_ci(metrics.aggregate_iqm, curves[:, j:j + 1], reps=reps)
-            iqm.append(float(point))
-            low.append(float(ci[0]))
-            high.append(float(ci[1]))
+        iqm, low, high = _iqm_band(curves, reps)
         line, = ax.plot(grid, iqm, lw=2, label=f"{s['label']}: IQM of {len(s['runs'])} runs, 95% CI")
         ax.fill_between(grid, low, high, color=line.get_color(), alpha=0.25)
         for r in s["runs"]:  # each run in full, since runs with an episode budget end at different steps
             ax.plot(*run_curve(r["run_dir"]), color=line.get_color(), lw=0.7, alpha=0.35)
-    ax.set_xlabel("env steps")
-    ax.set_ylabel("100-episode average return")
-    ax.legend()
-    ax.grid(alpha=0.3)
-    fig.tight_layout()
-    out = Path(out)
-    from rlcore.atomic import atomic_path
-    with atomic_path(out) as tmp:
-        fig.savefig(tmp, dpi=110)
-    plt.close(fig)
-    return out
+    return _save_figure(fig, ax, "100-episode average return", out)
+
+
+def plot_evals(result: dict, out: Path, reps: int = 1000) -> Path | None:
+    """IQM of the periodic evaluations' mean return (selection seeds) over env steps, 95 % CI band, per
+    sweep; each run drawn thin. ``None`` (no file) when no run has periodic evaluations.
+
+    The band covers the evaluation steps every run reached; a collapse shows as one run's dip.
+    """
+    sweeps = [s for s in result["sweeps"] if all(r["story"].evaluations for r in s["runs"])]
+    if not sweeps:
+        return None
+    from rlcore.eval_history import read_evals
+
+    fig, ax = _figure()
+    for s in sweeps:
+        runs = [read_evals(r["run_dir"]) for r in s["runs"]]
+        steps = sorted(set.intersection(*({e.env_steps for e in evals} for evals in runs)))
+        line = None
+        if steps:
+            curves = np.array([[next(e.mean for e in evals if e.env_steps == x) for x in steps] for evals in runs])
+            iqm, low, high = _iqm_band(curves, reps)
+            line, = ax.plot(steps, iqm, lw=2, label=f"{s['label']}: IQM of {len(runs)} runs, 95% CI")
+            ax.fill_between(steps, low, high, color=line.get_color(), alpha=0.25)
+        for evals in runs:
+            ax.plot([e.env_steps for e in evals], [e.mean for e in evals], lw=0.7, alpha=0.45,
+                            color=line.get_color() if line else None)
+    return _save_figure(fig, ax, "periodic evaluation, mean return", out)

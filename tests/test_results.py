@@ -31,3 +31,17 @@ def readme_iqm_cell(name: str) -> str:
             if line.startswith("|") and card in line]
     assert len(rows) == 1, f"{name}: {len(rows)} README rows link to {card}"
     return [cell.strip() for cell in rows[0].strip().strip("|").split("|")][-1]
+
+
+@pytest.mark.parametrize("name", SWEPT)
+def test_the_experiment_page_tells_each_kept_sweeps_collapses_as_its_evaluations_show_them(name):
+    """The page's summary of collapses and keep-best (docgen's sweep-stability region) recomputed from the
+    kept evals.csv files; and a seed that collapsed is listed with where it fell."""
+    from rlcore.eval_history import collapse_text, stability_summary
+
+    experiment = name.split("__")[0]
+    page = (ROOT / "docs" / "experiments" / f"{experiment}.md").read_text()
+    stories = [r["story"] for r in load_runs(KEPT / name)]
+    assert stability_summary(stories) in page
+    for st in stories:
+        assert all(collapse_text(c) in page for c in st.collapses)

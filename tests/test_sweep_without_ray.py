@@ -109,13 +109,14 @@ def test_report_keep_copies_what_the_report_reads_and_nothing_else(tmp_path, cap
         (run_dir / "model" / "meta.json").write_text(json.dumps({
             "seed": seed, "env_steps": 1000 * (seed + 1), "wall_seconds": 2.0, "evaluation": {"episodes": 5, "mean": score}}))
         (run_dir / "metrics.csv").write_text("episode,env_steps,av_latest_points\n1,10,1.0\n2,1000,%s\n" % score)
-        (run_dir / "evals.csv").write_text("env_steps,mean\n1000,%s\n" % score)
+        (run_dir / "evals.csv").write_text("env_steps,episode,eval_mean,eval_std,eval_time_limit_share\n"
+                                           "1000,2,%s,1.0,0.0\n" % score)
         (run_dir / "checkpoint.npz").write_bytes(b"large")
     code, out, err = run(capsys, "report", str(sweep), "--keep", str(kept), "--reps", "200")
     assert code == 0, err
     copied = sorted(str(p.relative_to(kept)) for p in kept.rglob("*") if p.is_file())
     per_run = ["evals.csv", "metrics.csv", "model/meta.json"]
-    assert copied == sorted(["report.md", "report_curves.png", "sweep.json"]
+    assert copied == sorted(["report.md", "report_curves.png", "report_evals.png", "sweep.json"]
                             + [f"seed={s}/{name}" for s in range(3) for name in per_run])
     assert not (sweep / "report.md").exists()  # the report is written where the copies are
     again = summarize([kept], reps=200)
@@ -123,6 +124,30 @@ def test_report_keep_copies_what_the_report_reads_and_nothing_else(tmp_path, cap
     assert [r["env_steps"] for r in load_runs(kept)] == [1000, 2000, 3000]
     code, _, err = run(capsys, "report", str(sweep), str(kept), "--keep", str(tmp_path / "other"))
     assert code == 2 and "--keep copies one sweep" in err and not (tmp_path / "other").exists()
+
+
+def test_report_tells_each_runs_collapses_and_which_weights_its_model_holds(tmp_path):
+    from rlcore.report import markdown
+
+    header = "env_steps,episode,eval_mean,eval_std,eval_time_limit_share\n"
+    for seed, (means, weights) in enumerate((((0.0, 15.0, 0.5, 16.0, 12.0), "best periodic evaluation"),
+                                             ((0.0, 8.0, 17.0, 17.5), "best periodic evaluation"),
+                                             ((0.0, 10.0, 1.0), "last"))):
+        run_dir = tmp_path / "sweep" / f"seed={seed}"
+        (run_dir / "model").mkdir(parents=True)
+        (run_dir / "model" / "meta.json").write_text(json.dumps({
+            "seed": seed, "env_steps": 4000, "wall_seconds": 2.0, "weights": weights,
+            "evaluation": {"episodes": 30, "mean": 10.0 + seed, "time_limit_share": 0.9}}))
+        (run_dir / "evals.csv").write_text(header + "".join(f"{1000 * (i + 1)},{i},{m},1.0,0.5\n"
+                                                            for i, m in enumerate(means)))
+    text = markdown(summarize([tmp_path / "sweep"], reps=200))
+    assert "| seed=0 | 0 | 10.000 | 90% | 4,000 |" in text
+    assert ("2 of 3 runs collapsed at least once (2 collapses, 1 not recovered); in 1 the model holds the best "
+            "evaluation's weights, which scored above the last evaluation (keep-best)") in text
+    assert ("- seed=0: 1 collapse (3,000: 0.50 after 15.00, back by 4,000); model: weights of the best evaluation "
+            "(16.00 at 4,000), the last scored 12.00") in text
+    assert "- seed=1: 0 collapses; model: weights of the best evaluation (17.50 at 4,000), also the last" in text
+    assert "- seed=2: 1 collapse (3,000: 1.00 after 10.00, not recovered); model: the last weights" in text
 
 
 def test_report_refuses_a_folder_that_mixes_experiments_or_algorithms(tmp_path, capsys):

@@ -1,0 +1,145 @@
+"""A run's periodic evaluations (``evals.csv``) read back: collapses, recoveries, and which weights the
+model kept. ``main.py report`` and the docs generator tell each seed's story from it. TensorFlow-free.
+
+A *collapse* is measured against the run's own scale, so the same rule serves returns that start
+negative (LunarLander) and returns that start near zero (Minitaur). With ``b`` the first evaluation's
+mean and ``g`` the best gain over ``b`` before evaluation ``i``:
+
+- the run has *learnt* once ``g`` is at least ``learnt`` (half) of the best gain it ever makes;
+- evaluation ``i`` of a run that has learnt starts a collapse when its mean is below ``b + drop * g``
+  (a quarter of the way up from the start);
+- the collapse ends at the first later evaluation back above ``b + recover * g`` (three quarters);
+  one that never comes back is unrecovered.
+
+Seed 0 of the Minitaur sweep, for instance: its first evaluation -0.08, then 14.76 at 350k and 0.19 at
+400k (a collapse), back at 12.06 by 500k.
+"""
+from __future__ import annotations
+
+import csv
+from dataclasses import dataclass
+from pathlib import Path
+
+from rlcore.errors import UserError
+
+DROP, RECOVER, LEARNT = 0.25, 0.75, 0.5
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    env_steps: int
+    mean: float
+    time_limit_share: float | None  # share of its episodes that lasted to the time limit
+
+
+@dataclass(frozen=True)
+class Collapse:
+    env_steps: int  # the evaluation that fell
+    mean: float
+    best_before: float  # the best evaluation before it
+    recovered_at: int | None  # the first evaluation back up, if any
+
+
+def read_evals(run_dir: Path) -> list[Evaluation]:
+    """The periodic evaluations of a run folder, in order; none if it has no ``evals.csv``."""
+    path = Path(run_dir) / "evals.csv"
+    if not path.is_file():
+        return []
+    try:
+        with open(path, newline="") as f:
+            rows = list(csv.DictReader(f))
+        return [Evaluation(int(float(r["env_steps"])), float(r["eval_mean"]),
+                           float(r["eval_time_limit_share"]) if r.get("eval_time_limit_share") not in (None, "")
+                           else None) for r in rows]
+    except (KeyError, ValueError, TypeError, UnicodeDecodeError) as exc:
+        raise UserError(f"{path} is damaged or not one of ours ({type(exc).__name__})") from None
+
+
+def collapses(evals: list[Evaluation], drop: float = DROP, recover: float = RECOVER,
+              learnt: float = LEARNT) -> list[Collapse]:
+    """The collapses of a run's evaluations, by the rule of this module's docstring."""
+    if len(evals) < 2:
+        return []
+    means = [e.mean for e in evals]
+    base, total_gain = means[0], max(means) - means[0]
+    if total_gain <= 0:
+        return []  # it never learnt anything to lose
+    found: list[Collapse] = []
+    open_at: tuple[int, float, float] | None = None  # (index, mean, gain) of the collapse not yet recovered
+    for i in range(1, len(means)):
+        if open_at is not None:
+            start, _, gain = open_at
+            if means[i] >= base + recover * gain:
+                found.append(Collapse(evals[start].env_steps, means[start], base + gain, evals[i].env_steps))
+                open_at = None
+            continue
+        gain = max(means[:i]) - base
+        if gain >= learnt * total_gain and means[i] < base + drop * gain:
+            open_at = (i, means[i], gain)
+    if open_at is not None:
+        start, _, gain = open_at
+        found.append(Collapse(evals[start].env_steps, means[start], base + gain, None))
+    return found
+
+
+@dataclass(frozen=True)
+class Story:
+    """What a run's periodic evaluations say about it."""
+    evaluations: int
+    best: Evaluation | None
+    last: Evaluation | None
+    collapses: list[Collapse]
+    kept_best: bool  # the model holds the best evaluation's weights (keep_best), not the last ones
+
+    @property
+    def shielded(self) -> bool:
+        """keep-best kept weights that evaluated better than the last ones."""
+        return self.kept_best and self.best is not None and self.last is not None and self.best.mean > self.last.mean
+
+
+def story(run_dir: Path, meta: dict) -> Story:
+    """A run folder's :class:`Story`, from its ``evals.csv`` and its model's ``meta.json``."""
+    evals = read_evals(run_dir)
+    best = max(reversed(evals), key=lambda e: e.mean) if evals else None  # a tie goes to the later one
+    return Story(len(evals), best, evals[-1] if evals else None, collapses(evals),
+                 meta.get("weights") == "best periodic evaluation")
+
+
+def steps_text(env_steps: int) -> str:
+    """1,000,062 -> "1M"; 1,950,000 -> "1.95M"; 650,000 -> "650k"; 1,234 -> "1,234"."""
+    if env_steps >= 1_000_000:
+        return f"{round(env_steps / 1e6, 2):g}M"
+    if env_steps >= 10_000:
+        return f"{round(env_steps / 1000):,}k"
+    return f"{env_steps:,}"
+
+
+def collapse_text(c: Collapse, digits: int = 2) -> str:
+    back = f"back by {steps_text(c.recovered_at)}" if c.recovered_at is not None else "not recovered"
+    return f"{steps_text(c.env_steps)}: {c.mean:.{digits}f} after {c.best_before:.{digits}f}, {back}"
+
+
+def story_text(s: Story, digits: int = 2) -> str:
+    """One line: the collapses, then which weights the model holds."""
+    if not s.evaluations:
+        return "no periodic evaluations"
+    parts = [f"{len(s.collapses)} collapse{'s' if len(s.collapses) != 1 else ''}"
+             + (f" ({'; '.join(collapse_text(c, digits) for c in s.collapses)})" if s.collapses else "")]
+    if s.kept_best and s.best is not None:
+        parts.append(f"model: weights of the best evaluation ({s.best.mean:.{digits}f} at {steps_text(s.best.env_steps)})"
+                     + (f", the last scored {s.last.mean:.{digits}f}" if s.shielded else ", also the last"))
+    else:
+        parts.append("model: the last weights")
+    return "; ".join(parts)
+
+
+def stability_summary(stories: list[Story]) -> str:
+    """One sentence over a sweep's runs: how many collapsed, how many collapses came back, and how often
+    keep-best kept weights that evaluated above the last ones."""
+    collapsed = sum(bool(st.collapses) for st in stories)
+    count = sum(len(st.collapses) for st in stories)
+    unrecovered = sum(c.recovered_at is None for st in stories for c in st.collapses)
+    shielded = sum(st.shielded for st in stories)
+    return (f"{collapsed} of {len(stories)} runs collapsed at least once ({count} collapse{'' if count == 1 else 's'}, "
+            f"{unrecovered} not recovered); in {shielded} the model holds the best evaluation's weights, which scored "
+            f"above the last evaluation (keep-best).")
