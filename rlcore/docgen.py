@@ -210,6 +210,12 @@ def region_sweep_stability(page: str, experiment: str) -> str:
     return sweep_stability(page, experiment)
 
 
+def region_seed_summary(page: str, experiment: str) -> str:
+    """A paragraph per kept sweep of an experiment: IQM, per-seed scores, the shipped model, collapses."""
+    from rlcore.docgen_sweeps import seed_summary
+    return seed_summary(page, experiment)
+
+
 def region_curves(page: str, experiment: str) -> str:
     """The training curves of the shipped models (and the sweeps' IQM curves), as images."""
     parts = []
@@ -289,7 +295,8 @@ def region_seed_ranges(page: str, arg: str) -> str:
 
 
 REGIONS = {"results-table": region_results_table, "gif-strip": region_gif_strip, "shipped": region_shipped,
-           "sweeps": region_sweeps, "sweep-stability": region_sweep_stability, "curves": region_curves, "csv-columns": region_csv_columns,
+           "sweeps": region_sweeps, "sweep-stability": region_sweep_stability,
+           "seed-summary": region_seed_summary, "curves": region_curves, "csv-columns": region_csv_columns,
            "meta-keys": region_meta_keys, "bars": region_bars,
            "seed-ranges": region_seed_ranges, "presets": region_presets}
 _REGION = re.compile(r"(<!-- generated:([\w-]+)(?: ([\w./-]+))? -->\n)(.*?)(<!-- /generated -->)", re.S)

@@ -1,6 +1,8 @@
-"""The ``sweep-stability`` region of the docs: what each kept sweep's periodic evaluations say about its
-seeds (collapses during training, and whether keep-best kept better weights than the last), read from the
-run folders in ``results/sweeps/``. Part of :mod:`rlcore.docgen`; TensorFlow-free."""
+"""The docs regions about kept sweeps' seeds, read from the run folders in ``results/sweeps/``:
+``sweep-stability`` (what each seed's periodic evaluations saw: collapses during training, and whether
+keep-best kept better weights than the last) and ``seed-summary`` (one paragraph per sweep for the README:
+the IQM, each seed's score and the shipped model's beside them). Part of :mod:`rlcore.docgen`;
+TensorFlow-free."""
 from __future__ import annotations
 
 from rlcore.docgen_data import REPO, read_json, shipped_models
@@ -41,4 +43,24 @@ def sweep_stability(page: str, experiment: str) -> str:
                              rows, "rrrrrrll"))
     if not parts:
         return "*No sweep over seeds is kept in `results/sweeps/` for this experiment yet.*"
+    return "\n\n".join(parts)
+
+
+def seed_summary(page: str, experiment: str) -> str:
+    from rlcore.docgen import iqm_text, link, score_text, sweep_score
+
+    parts = []
+    for m in shipped_models():
+        if m.experiment != experiment or m.sweep is None:
+            continue
+        runs = _runs(m.sweep.folder)
+        per_seed = ", ".join(f"{seed}: {sweep_score(score, m)}" for seed, score in m.sweep.seeds)
+        parts.append(f"{m.title}, the same recipe over {len(m.sweep.seeds)} seeds "
+                     f"([report]({link(page, m.sweep.folder + '/report.md')})): IQM [95% CI] **{iqm_text(m)}**; "
+                     f"per seed {per_seed}; the shipped model (seed {m.meta.get('seed')}, a run of its own) "
+                     f"{score_text(m)}. "
+                     f"During training {stability_summary([st for _, st in runs])}")
+    if not parts:
+        return (f"*The sweep over seeds of {experiment} is not kept in `results/sweeps/` yet; its figures appear "
+                f"here when it is.*")
     return "\n\n".join(parts)

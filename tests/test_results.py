@@ -45,3 +45,19 @@ def test_the_experiment_page_tells_each_kept_sweeps_collapses_as_its_evaluations
     assert stability_summary(stories) in page
     for st in stories:
         assert all(collapse_text(c) in page for c in st.collapses)
+
+
+def test_a_seed_summary_gives_the_iqm_each_seed_and_the_shipped_model_beside_them():
+    """The README's paragraph per kept sweep (docgen's seed-summary region), on the CartPole DQN sweep."""
+    from rlcore.docgen_sweeps import seed_summary
+    from rlcore.eval_history import stability_summary
+
+    text = seed_summary("README.md", "cartpole")
+    runs = load_runs(KEPT / "cartpole__dqn")
+    iqm, lo, hi = summarize([KEPT / "cartpole__dqn"], reps=5000)["sweeps"][0]["aggregates"]["iqm"]
+    first = text.split("\n\n")[0]
+    assert f"IQM [95% CI] **{iqm:.1f} [{lo:.1f}, {hi:.1f}]**" in first
+    assert "per seed " + ", ".join(f"{r['seed']}: {r['score']:.1f}" for r in runs) in first
+    assert "the shipped model (seed 0, a run of its own) 500.0" in first
+    assert first.endswith(stability_summary([r["story"] for r in runs]))
+    assert "not kept" in seed_summary("README.md", "no_such_experiment")
