@@ -6,7 +6,7 @@ TensorFlow-free."""
 from __future__ import annotations
 
 from rlcore.docgen_data import REPO, read_json, shipped_models
-from rlcore.eval_history import collapse_text, stability_summary, steps_text, story
+from rlcore.eval_history import stability_summary, steps_text, story
 
 
 def _runs(folder: str) -> list[tuple[dict, object]]:
@@ -16,6 +16,15 @@ def _runs(folder: str) -> list[tuple[dict, object]]:
         meta = read_json(meta_path)
         runs.append((meta, story(meta_path.parent.parent, meta)))
     return sorted(runs, key=lambda run: run[0]["seed"])
+
+
+def collapses_cell(collapses: list) -> str:
+    """``2: 40k → 58k, 124k → 138k`` (``never`` for one not recovered); ``none``."""
+    if not collapses:
+        return "none"
+    return f"{len(collapses)}: " + ", ".join(
+        f"{steps_text(c.env_steps)} → {steps_text(c.recovered_at) if c.recovered_at is not None else 'never'}"
+        for c in collapses)
 
 
 def sweep_stability(page: str, experiment: str) -> str:
@@ -30,17 +39,22 @@ def sweep_stability(page: str, experiment: str) -> str:
         for meta, st in runs:
             ev = meta.get("evaluation") or {}
             share = ev.get("time_limit_share")
-            rows.append([str(meta["seed"]), sweep_score(ev.get("success_share", ev.get("mean")), m),
-                         "–" if share is None else f"{share:.0%}", str(st.evaluations),
-                         f"{st.best.mean:.2f} at {steps_text(st.best.env_steps)}" if st.best else "–",
-                         f"{st.last.mean:.2f}" if st.last else "–",
-                         "; ".join(collapse_text(c) for c in st.collapses) or "none",
-                         ("best evaluation" if st.kept_best else "last")])
+            deepest = min(st.collapses, key=lambda c: c.mean, default=None)
+            rows.append([str(meta["seed"]), sweep_score(ev.get("success_share", ev.get("mean")), m)
+                         + ("" if share is None else f" ({share:.0%})"),
+                         f"{sweep_score(st.best.mean, m)} at {steps_text(st.best.env_steps)}" if st.best else "–",
+                         sweep_score(st.last.mean, m) if st.last else "–",
+                         collapses_cell(st.collapses),
+                         f"{sweep_score(deepest.mean, m)} after {sweep_score(deepest.best_before, m)}" if deepest else "–"])
+        kept = [str(meta["seed"]) for meta, st in runs if st.kept_best]
+        weights = ("" if len(kept) == len(runs) else
+                   f" The models of seeds {', '.join(kept)} hold their best evaluation's weights (keep-best), the "
+                   f"others their last." if kept else " Every model holds its run's last weights.")
         parts.append(f"**[{m.name}]({link(page, m.sweep.folder + '/report.md')})**: "
-                     f"{stability_summary([st for _, st in runs])}\n\n"
-                     + table(["seed", "unseen seeds", "to time limit", "periodic evaluations", "best (at)", "last",
-                              "collapses (at: mean after the best before it, back by)", "model holds the weights of"],
-                             rows, "rrrrrrll"))
+                     f"{stability_summary([st for _, st in runs])}{weights} Beside each unseen-seed score, the share "
+                     f"of its episodes that lasted to the time limit.\n\n"
+                     + table(["seed", "unseen seeds", "best evaluation (at)", "last", "collapses: at → back by",
+                              "deepest"], rows, "rrrrll"))
     if not parts:
         return "*No sweep over seeds is kept in `results/sweeps/` for this experiment yet.*"
     return "\n\n".join(parts)

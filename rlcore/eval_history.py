@@ -141,5 +141,5 @@ def stability_summary(stories: list[Story]) -> str:
     unrecovered = sum(c.recovered_at is None for st in stories for c in st.collapses)
     shielded = sum(st.shielded for st in stories)
     return (f"{collapsed} of {len(stories)} runs collapsed at least once ({count} collapse{'' if count == 1 else 's'}, "
-            f"{unrecovered} not recovered); in {shielded} the model holds the best evaluation's weights, which scored "
-            f"above the last evaluation (keep-best).")
+            f"{unrecovered} not recovered); in {shielded} run{'' if shielded == 1 else 's'} keep-best mattered: the "
+            f"model holds an earlier evaluation's weights, which scored above the run's last evaluation.")

@@ -142,8 +142,8 @@ def test_report_tells_each_runs_collapses_and_which_weights_its_model_holds(tmp_
                                                             for i, m in enumerate(means)))
     text = markdown(summarize([tmp_path / "sweep"], reps=200))
     assert "| seed=0 | 0 | 10.000 | 90% | 4,000 |" in text
-    assert ("2 of 3 runs collapsed at least once (2 collapses, 1 not recovered); in 1 the model holds the best "
-            "evaluation's weights, which scored above the last evaluation (keep-best)") in text
+    assert ("2 of 3 runs collapsed at least once (2 collapses, 1 not recovered); in 1 run keep-best mattered: the "
+            "model holds an earlier evaluation's weights, which scored above the run's last evaluation.") in text
     assert ("- seed=0: 1 collapse (3,000: 0.50 after 15.00, back by 4,000); model: weights of the best evaluation "
             "(16.00 at 4,000), the last scored 12.00") in text
     assert "- seed=1: 0 collapses; model: weights of the best evaluation (17.50 at 4,000), also the last" in text
