@@ -125,8 +125,9 @@ def _model(args):
     if not is_run_in_progress(folder):
         yield folder, str(folder)
         return
-    if getattr(args, "record", False):
-        raise UserError(f"--record writes into a model folder; {folder} is a run in progress, which has none")
+    if getattr(args, "record", False) or getattr(args, "record_further", False):
+        flag = "--record" if args.record else "--record-further"
+        raise UserError(f"{flag} writes into a model folder; {folder} is a run in progress, which has none")
     with tempfile.TemporaryDirectory(prefix="snapshot-") as tmp:
         meta = model_from_checkpoint(folder, tmp, args.experiment, args.algo)
         print(f"model:   the last checkpoint of {folder} (episode {meta['episodes']:,}, "
@@ -137,9 +138,15 @@ def _model(args):
 def cmd_evaluate(args) -> int:
     from rlcore.policies import load_policy
 
+    if args.record and args.record_further:
+        raise UserError("give --record (the model's evaluation) or --record-further (one more), not both")
     with _model(args) as (model_dir, name):
         exp, meta, policy = load_policy(model_dir, args.experiment, args.algo)
         episodes = shipping.eval_episodes(exp, args.episodes)
+        if args.record_further:
+            shipping.evaluate_further_into_meta(model_dir, episodes, args.seed_base)
+            print(f"recorded in {model_dir / 'meta.json'} (further_evaluations)")
+            return 0
         if args.record:
             shipping.evaluate_into_meta(model_dir, episodes, args.seed_base)
             print(f"recorded in {model_dir / 'meta.json'}")
@@ -287,15 +294,22 @@ def cmd_sweep(args) -> int:
 
 def cmd_report(args) -> int:
     from rlcore.extras import require
-    from rlcore.report import keep, markdown, plot_curves, plot_evals, summarize
+    from rlcore.report import KEPT_FILES, is_run_folder, keep, keep_runs, markdown, summarize
+    from rlcore.report_plots import plot_curves, plot_evals
 
     require("rliable.metrics", "The report command")  # the sweep extra, or one line saying so
     folders = [Path(d) for d in args.sweep_dirs]
+    runs = [d for d in folders if is_run_folder(d)]
+    if runs and not args.keep:
+        raise UserError(f"{runs[0]} is a finished run, not a sweep: to report single runs of one recipe over "
+                        f"seeds, keep them together first (--keep DIR)")
     if args.keep:
-        if len(folders) != 1:
+        if runs and len(runs) != len(folders):
+            raise UserError("--keep takes one sweep folder, or finished run folders only, not both")
+        if not runs and len(folders) != 1:
             raise UserError("--keep copies one sweep: give one SWEEP_DIR with it")
-        folders = [keep(folders[0], Path(args.keep))]
-        print(f"kept: {folders[0]} (sweep.json; per run model/meta.json, metrics.csv, evals.csv)")
+        folders = [keep_runs(runs, Path(args.keep)) if runs else keep(folders[0], Path(args.keep))]
+        print(f"kept: {folders[0]} (sweep.json; per run {', '.join(KEPT_FILES)}, where the run has them)")
     result = summarize(folders, reps=args.reps)
     text = markdown(result)
     print(text)

@@ -123,6 +123,10 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
                            help="episode i uses seed SEED_BASE+i (default: the experiment's unseen range)")
             p.add_argument("--record", action="store_true",
                            help="write the result into the model folder's meta.json as its evaluation")
+            p.add_argument("--record-further", action="store_true",
+                           help="add the result to the model folder's meta.json as a further evaluation on other "
+                                "unseen seeds, its evaluation kept; by default on the seeds right after the last "
+                                "ones recorded (a held-out check of a model chosen by its evaluation)")
         else:
             p.add_argument("--out", default=None,
                            help="an .mp4 or a .gif path (a GIF: ~320 px wide, every few frames, looping), "
@@ -184,12 +188,15 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
                                         "(rliable's method); with two sweeps, P(first beats second). Writes "
                                         "report.md, report_curves.png and, where runs evaluated periodically, "
                                         "report_evals.png into the first sweep folder.")
-    report.add_argument("sweep_dirs", nargs="+", metavar="SWEEP_DIR")
+    report.add_argument("sweep_dirs", nargs="+", metavar="SWEEP_DIR",
+                        help="a sweep's folder (several: one report, compared); with --keep, finished run "
+                             "folders of one recipe over seeds (main.py train ... --seed S) may be given instead")
     report.add_argument("--reps", type=whole_number(Allowed(low=100, high=10**6)), default=5000, help="bootstrap resamples")
     report.add_argument("--keep", metavar="DIR", default=None,
-                        help="first copy sweep.json and, per run, model/meta.json, metrics.csv and evals.csv "
+                        help="first copy sweep.json and, per run, model/meta.json and its CSV tables "
                              "(not the checkpoints) into DIR, a folder git keeps such as "
-                             "results/sweeps/NAME, and write the report there")
+                             "results/sweeps/NAME, and write the report there; run folders go to DIR/seed=S "
+                             "with a sweep.json written for them")
 
     plot = sub.add_parser("plot", help="write the training plots of a run folder (running, interrupted "
                                        "or finished)",

@@ -216,6 +216,12 @@ def region_seed_summary(page: str, experiment: str) -> str:
     return seed_summary(page, experiment)
 
 
+def region_seed_runs(page: str, experiment: str) -> str:
+    """Each kept sweep's seeds: scores (and further evaluations), env steps, wall time, speed, stop."""
+    from rlcore.docgen_sweeps import seed_runs
+    return seed_runs(page, experiment)
+
+
 def region_curves(page: str, experiment: str) -> str:
     """The training curves of the shipped models (and the sweeps' IQM curves), as images."""
     parts = []
@@ -296,7 +302,7 @@ def region_seed_ranges(page: str, arg: str) -> str:
 
 REGIONS = {"results-table": region_results_table, "gif-strip": region_gif_strip, "shipped": region_shipped,
            "sweeps": region_sweeps, "sweep-stability": region_sweep_stability,
-           "seed-summary": region_seed_summary, "curves": region_curves, "csv-columns": region_csv_columns,
+           "seed-summary": region_seed_summary, "seed-runs": region_seed_runs, "curves": region_curves, "csv-columns": region_csv_columns,
            "meta-keys": region_meta_keys, "bars": region_bars,
            "seed-ranges": region_seed_ranges, "presets": region_presets}
 _REGION = re.compile(r"(<!-- generated:([\w-]+)(?: ([\w./-]+))? -->\n)(.*?)(<!-- /generated -->)", re.S)

@@ -1,7 +1,8 @@
 """The docs regions about kept sweeps' seeds, read from the run folders in ``results/sweeps/``:
 ``sweep-stability`` (what each seed's periodic evaluations saw: collapses during training, and whether
-keep-best kept better weights than the last) and ``seed-summary`` (one paragraph per sweep for the README:
-the IQM, each seed's score and the shipped model's beside them). Part of :mod:`rlcore.docgen`;
+keep-best kept better weights than the last), ``seed-runs`` (each seed's scores, further evaluations,
+env steps, wall time and speed) and ``seed-summary`` (one paragraph per sweep for the README: the IQM,
+each seed's score and the shipped model's beside them). Part of :mod:`rlcore.docgen`;
 TensorFlow-free."""
 from __future__ import annotations
 
@@ -61,20 +62,58 @@ def sweep_stability(page: str, experiment: str) -> str:
 
 
 def seed_summary(page: str, experiment: str) -> str:
-    from rlcore.docgen import iqm_text, link, score_text, sweep_score
+    from rlcore.docgen import iqm_text, link, score_text
 
     parts = []
     for m in shipped_models():
         if m.experiment != experiment or m.sweep is None:
             continue
         runs = _runs(m.sweep.folder)
-        per_seed = ", ".join(f"{seed}: {sweep_score(score, m)}" for seed, score in m.sweep.seeds)
+        per_seed = "; ".join(f"{meta['seed']}: {evaluation_cell(meta['evaluation'], m)} after "
+                             f"{meta['env_steps']:,} env steps, {_hours(meta['wall_seconds'])}" for meta, _ in runs)
         parts.append(f"{m.title}, the same recipe over {len(m.sweep.seeds)} seeds "
                      f"([report]({link(page, m.sweep.folder + '/report.md')})): IQM [95% CI] **{iqm_text(m)}**; "
                      f"per seed {per_seed}; the shipped model (seed {m.meta.get('seed')}, a run of its own) "
                      f"{score_text(m)}. "
                      f"During training {stability_summary([st for _, st in runs])}")
     if not parts:
-        return (f"*The sweep over seeds of {experiment} is not kept in `results/sweeps/` yet; its figures appear "
-                f"here when it is.*")
+        return "*Not kept in `results/sweeps/` yet: the figures appear here when the runs are.*"
+    return "\n\n".join(parts)
+
+
+def _hours(seconds: float) -> str:
+    return f"{seconds / 3600:.1f} h" if seconds >= 3600 else f"{seconds:,.0f} s"
+
+
+def evaluation_cell(evaluation: dict, m) -> str:
+    """``flag in 9 of 10`` (Mario), ``18.6 over 30``: one recorded evaluation, as the card writes it."""
+    from rlcore.docgen import _success_word, num
+
+    if "success_share" in evaluation:
+        won = round(evaluation["success_share"] * evaluation["episodes"])
+        return f"{_success_word(m)} in {won} of {evaluation['episodes']}"
+    return f"{num(evaluation['mean'])} over {evaluation['episodes']}"
+
+
+def seed_runs(page: str, experiment: str) -> str:
+    from rlcore.docgen import link, score_text, table
+
+    parts = []
+    for m in shipped_models():
+        if m.experiment != experiment or m.sweep is None:
+            continue
+        rows = []
+        for meta, _ in _runs(m.sweep.folder):
+            ev = meta.get("evaluation") or {}
+            further = "; ".join(f"{evaluation_cell(f, m)} ({f.get('seeds')})"
+                                for f in meta.get("further_evaluations", [])) or "–"
+            rows.append([str(meta["seed"]), evaluation_cell(ev, m), further, f"{meta['env_steps']:,}",
+                         _hours(meta["wall_seconds"]), f"{meta['env_steps'] / max(meta['wall_seconds'], 1e-9):,.0f}",
+                         meta.get("stopped_by") or "–"])
+        parts.append(f"**[{m.name}]({link(page, m.sweep.folder + '/report.md')})**, beside the shipped model's "
+                     f"{score_text(m)}:\n\n"
+                     + table(["seed", "unseen seeds", "further unseen seeds", "env steps", "wall", "env steps/s",
+                              "stopped by"], rows, "rrrrrrl"))
+    if not parts:
+        return "*No sweep over seeds is kept in `results/sweeps/` for this experiment yet.*"
     return "\n\n".join(parts)

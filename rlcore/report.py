@@ -12,7 +12,6 @@ return, or for Mario the share of episodes that reached the flag. TensorFlow-fre
 """
 from __future__ import annotations
 
-import csv
 import json
 import shutil
 from pathlib import Path
@@ -86,6 +85,8 @@ def load_runs(sweep_dir: Path) -> list[dict]:
                      "eval_episodes": ev.get("episodes"), "env_steps": meta["env_steps"],
                      "wall_seconds": meta["wall_seconds"], "run_dir": meta_path.parent.parent,
                      "cpu": meta.get("cpu"), "time_limit_share": ev.get("time_limit_share"),
+                     "further": [(f["episodes"], f.get("success_share", f.get("mean")))
+                                 for f in meta.get("further_evaluations", [])],
                      "story": story(meta_path.parent.parent, meta),
                      "what": f"{meta.get('experiment')} {meta.get('algo')}"})
     if not rows:
@@ -97,9 +98,61 @@ def load_runs(sweep_dir: Path) -> list[dict]:
     return rows
 
 
-#: what ``keep`` copies of a run folder: what the report reads (meta.json, metrics.csv) and the periodic
-#: evaluations (evals.csv); a sweep's checkpoints stay behind
-KEPT_FILES = ("model/meta.json", "metrics.csv", "evals.csv")
+#: what ``keep`` copies of a run folder: what the report reads (meta.json, metrics.csv), the periodic
+#: evaluations (evals.csv) and PPO's rollout table (rollouts.csv); checkpoints and models stay behind
+KEPT_FILES = ("model/meta.json", "metrics.csv", "evals.csv", "rollouts.csv")
+
+
+def is_run_folder(folder: Path) -> bool:
+    """A finished run's folder (``model/meta.json``), as opposed to a sweep's folder of such runs."""
+    return (Path(folder) / "model" / "meta.json").is_file()
+
+
+def _copy(pairs: list[tuple[Path, Path]]) -> None:
+    for source, target in pairs:
+        target.parent.mkdir(parents=True, exist_ok=True)
+        write_atomic(target, lambda tmp, source=source: shutil.copyfile(source, tmp))
+
+
+#: config fields kept runs may differ in: budgets, which a resume may give again (the stop rule ends a run)
+BUDGETS = ("max_env_steps", "max_episodes")
+
+
+def keep_runs(run_dirs: list[Path], dest: Path) -> Path:
+    """Keep single runs of one recipe over seeds (``main.py train ... --seed S``, one run folder each) as
+    a sweep would be kept: per run :data:`KEPT_FILES` into ``dest/seed=S/``, and a ``sweep.json`` naming
+    the experiment, algorithm, preset, seeds and (for Mario) the level, so that ``report`` and the docs
+    generator read ``dest`` like any kept sweep. The runs must differ in their seed (and :data:`BUDGETS`) only."""
+    from rlcore.experiment import get_experiment
+
+    run_dirs, dest = [Path(d) for d in run_dirs], Path(dest)
+    metas = [json.loads((d / "model" / "meta.json").read_text()) for d in run_dirs]
+    first = metas[0]
+    for d, meta in zip(run_dirs, metas):
+        what = (meta.get("experiment"), meta.get("algo"), meta.get("preset"))
+        if what != (first.get("experiment"), first.get("algo"), first.get("preset")):
+            raise UserError(f"{d} is a run of {' '.join(map(str, what))}, {run_dirs[0]} of {first.get('experiment')} "
+                            f"{first.get('algo')} {first.get('preset')}: kept runs are one recipe over seeds")
+        differ = sorted(k for k in set(meta.get("config", {})) | set(first.get("config", {}))
+                        if k not in BUDGETS and meta.get("config", {}).get(k) != first.get("config", {}).get(k))
+        if differ:
+            raise UserError(f"{d} and {run_dirs[0]} differ in {', '.join(differ)}: kept runs are one recipe over seeds")
+    seeds = [meta["seed"] for meta in metas]
+    if len(set(seeds)) != len(seeds):
+        raise UserError(f"two of the runs have the same seed ({', '.join(map(str, seeds))}): keep one run per seed")
+    if not all(meta.get("evaluation") for meta in metas):
+        raise UserError("a run has no evaluation on unseen seeds in its model/meta.json: evaluate it first "
+                        "(main.py evaluate ... --model RUN_DIR --record)")
+    exp = get_experiment(first["experiment"])
+    fields = exp.shipped_by.fields if exp.shipped_by else ()
+    sweep = {"experiment": first["experiment"], "algo": first["algo"], "name": dest.name, "folder": str(dest.resolve()),
+             "seeds": sorted(seeds), "grid": {}, "preset": first.get("preset"),
+             "overrides": {f: first["config"][f] for f in fields}}
+    pairs = [(d / name, dest / f"seed={meta['seed']}" / name) for d, meta in zip(run_dirs, metas)
+             for name in KEPT_FILES if (d / name).is_file()]
+    _copy(pairs)
+    write_atomic(dest / "sweep.json", lambda tmp: tmp.write_text(json.dumps(sweep, indent=2) + "\n"))
+    return dest
 
 
 def keep(sweep_dir: Path, dest: Path) -> Path:
@@ -112,29 +165,8 @@ def keep(sweep_dir: Path, dest: Path) -> Path:
     for run in runs:
         copies += [(run["run_dir"] / name, dest / run["trial"] / name) for name in KEPT_FILES
                    if (run["run_dir"] / name).is_file()]
-    for source, target in copies:
-        target.parent.mkdir(parents=True, exist_ok=True)
-        write_atomic(target, lambda tmp, source=source: shutil.copyfile(source, tmp))
+    _copy(copies)
     return dest
-
-
-def run_curve(run_dir: Path) -> tuple[np.ndarray, np.ndarray]:
-    """One run's (env steps, 100-episode average return) at each episode's end, from metrics.csv."""
-    with open(Path(run_dir) / "metrics.csv", newline="") as f:
-        rows = list(csv.DictReader(f))
-    return (np.array([float(r["env_steps"]) for r in rows]),
-            np.array([float(r["av_latest_points"]) for r in rows]))
-
-
-def learning_curve(run_dirs: list[Path], points: int = 40) -> tuple[np.ndarray, np.ndarray]:
-    """(env steps grid, [runs, points] 100-episode average return), each run interpolated.
-
-    The grid ends where the shortest run ends, so every point aggregates every run.
-    """
-    curves = [run_curve(d) for d in run_dirs]
-    end = min(s[-1] for s, _ in curves)
-    grid = np.linspace(0, end, points)
-    return grid, np.stack([np.interp(grid, s, v) for s, v in curves])
 
 
 # --------------------------------------------------------------------------------------- report
@@ -181,6 +213,11 @@ def markdown(result: dict) -> str:
         lines += ["", f"| over {len(s['runs'])} runs | point | 95% CI (stratified bootstrap) |",
                   "| --- | ---: | --- |"]
         lines += [f"| {name} | {p:.3f} | [{lo:.3f}, {hi:.3f}] |" for name, (p, lo, hi) in s["aggregates"].items()]
+        if any(r.get("further") for r in s["runs"]):
+            lines += ["", "Further evaluations on other unseen seeds (`evaluate --record-further`), each run's in order:",
+                      ""] + [f"- {r['trial']}: " + ("; ".join(f"{score:.3f} over {episodes} episodes"
+                                                             for episodes, score in r["further"]) or "none")
+                             for r in s["runs"]]
         lines += ["", *stability_lines(s["runs"]), ""]
     if "probability_of_improvement" in result:
         p, lo, hi = result["probability_of_improvement"]
@@ -198,83 +235,3 @@ def stability_lines(runs: list[dict]) -> list[str]:
     lines = [f"Periodic evaluations (selection seeds): {stability_summary(stories)}", ""]
     lines += [f"- {r['trial']}: {story_text(r['story'])}" for r in runs]
     return lines
-
-
-def _iqm_band(curves: np.ndarray, reps: int) -> tuple[list, list, list]:
-    """IQM over runs at each column of a [runs, points] matrix, with its 95 % bootstrap interval."""
-    metrics = require("rliable.metrics", "A sweep report")  # the sweep extra
-    iqm, low, high = [], [], []
-    for j in range(curves.shape[1]):
-        point, ci = stratified_bootstrap_ci(metrics.aggregate_iqm, curves[:, j:j + 1], reps=reps)
-        iqm.append(float(point))
-        low.append(float(ci[0]))
-        high.append(float(ci[1]))
-    return iqm, low, high
-
-
-def _save_figure(fig, ax, ylabel: str, out: Path) -> Path:
-    import matplotlib.pyplot as plt
-
-    from rlcore.atomic import atomic_path
-
-    ax.set_xlabel("env steps")
-    ax.set_ylabel(ylabel)
-    ax.legend()
-    ax.grid(alpha=0.3)
-    fig.tight_layout()
-    out = Path(out)
-    with atomic_path(out) as tmp:
-        fig.savefig(tmp, dpi=110)
-    plt.close(fig)
-    return out
-
-
-def _figure():
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt.subplots(figsize=(8, 4.5))
-
-
-def plot_curves(result: dict, out: Path, reps: int = 1000) -> Path:
-    """IQM of the 100-episode average return over env steps, with its 95 % CI band, per sweep.
-
-    The band covers the env steps every run reached; each run is also drawn in full, thin.
-    """
-    fig, ax = _figure()
-    for s in result["sweeps"]:
-        grid, curves = learning_curve([r["run_dir"] for r in s["runs"]])
-        iqm, low, high = _iqm_band(curves, reps)
-        line, = ax.plot(grid, iqm, lw=2, label=f"{s['label']}: IQM of {len(s['runs'])} runs, 95% CI")
-        ax.fill_between(grid, low, high, color=line.get_color(), alpha=0.25)
-        for r in s["runs"]:  # each run in full, since runs with an episode budget end at different steps
-            ax.plot(*run_curve(r["run_dir"]), color=line.get_color(), lw=0.7, alpha=0.35)
-    return _save_figure(fig, ax, "100-episode average return", out)
-
-
-def plot_evals(result: dict, out: Path, reps: int = 1000) -> Path | None:
-    """IQM of the periodic evaluations' mean return (selection seeds) over env steps, 95 % CI band, per
-    sweep; each run drawn thin. ``None`` (no file) when no run has periodic evaluations.
-
-    The band covers the evaluation steps every run reached; a collapse shows as one run's dip.
-    """
-    sweeps = [s for s in result["sweeps"] if all(r["story"].evaluations for r in s["runs"])]
-    if not sweeps:
-        return None
-    from rlcore.eval_history import read_evals
-
-    fig, ax = _figure()
-    for s in sweeps:
-        runs = [read_evals(r["run_dir"]) for r in s["runs"]]
-        steps = sorted(set.intersection(*({e.env_steps for e in evals} for evals in runs)))
-        line = None
-        if steps:
-            curves = np.array([[next(e.mean for e in evals if e.env_steps == x) for x in steps] for evals in runs])
-            iqm, low, high = _iqm_band(curves, reps)
-            line, = ax.plot(steps, iqm, lw=2, label=f"{s['label']}: IQM of {len(runs)} runs, 95% CI")
-            ax.fill_between(steps, low, high, color=line.get_color(), alpha=0.25)
-        for evals in runs:
-            ax.plot([e.env_steps for e in evals], [e.mean for e in evals], lw=0.7, alpha=0.45,
-                            color=line.get_color() if line else None)
-    return _save_figure(fig, ax, "periodic evaluation, mean return", out)

@@ -137,6 +137,42 @@ def evaluate_into_meta(model_dir: Path, episodes: int, seed_base: int | None = N
     return meta
 
 
+def seed_range(evaluation: dict) -> range:
+    """The seeds a recorded evaluation played (its ``seeds``, ``"1000000..1000009"``)."""
+    first, last = (int(x) for x in evaluation["seeds"].split(".."))
+    return range(first, last + 1)
+
+
+def evaluate_further_into_meta(model_dir: Path, episodes: int, seed_base: int | None = None) -> dict:
+    """Evaluate a model again on unseen seeds that no recorded evaluation of it played, and add the
+    result to its meta.json's ``further_evaluations`` (its ``evaluation`` kept). By default the seeds
+    follow the last ones recorded. A held-out check: the model was chosen by its ``evaluation``."""
+    from rlcore.atomic import write_json
+    from rlcore.machine import this_machine
+    from rlcore.policies import load_policy
+
+    exp, meta, policy = load_policy(model_dir)
+    recorded = [ev for ev in [meta.get("evaluation"), *meta.get("further_evaluations", [])] if ev and ev.get("seeds")]
+    if seed_base is None:
+        seed_base = max((seed_range(ev).stop for ev in recorded), default=exp.eval_seed_base)
+    wanted = range(seed_base, seed_base + episodes)
+    if wanted.start < exp.eval_seed_base or wanted.stop > exp.selection_seed_base:
+        raise UserError(f"--seed-base {seed_base} with {episodes} episodes plays seeds {wanted.start}..{wanted.stop - 1}, "
+                        f"outside {exp.name}'s unseen range {exp.eval_seed_base}..{exp.selection_seed_base - 1}")
+    for ev in recorded:
+        played = seed_range(ev)
+        if wanted.start < played.stop and played.start < wanted.stop:
+            raise UserError(f"seeds {wanted.start}..{wanted.stop - 1} overlap those of an evaluation already recorded "
+                            f"({ev['seeds']}); a further evaluation plays other seeds: leave out --seed-base, or "
+                            f"give one from {max(r.stop for r in map(seed_range, recorded))}")
+    summary, line = run_evaluation(exp, policy, episodes, seed_base)
+    summary["machine"] = this_machine()
+    meta["further_evaluations"] = [*meta.get("further_evaluations", []), summary]
+    write_json(model_dir / "meta.json", meta)
+    print(f"further evaluation (unseen seeds): {line}")
+    return meta
+
+
 def publish(model_dir: Path, target: Path) -> None:
     """Make ``target`` (a saved_networks/ folder) an exact copy of ``model_dir``, replacing it whole.
 

@@ -272,6 +272,36 @@ def test_evaluate_and_render_a_run_in_progress_and_a_finished_run_folder(capsys,
     assert code == 0 and f"({spec.run_dir / 'model'}): " in out, err
 
 
+def test_a_further_evaluation_plays_the_next_unseen_seeds_and_keeps_the_evaluation(capsys, tmp_path, monkeypatch):
+    """evaluate --record-further: a held-out check added beside the model's evaluation, on seeds no
+    recorded evaluation played; overlapping or seen seeds, both flags, a run in progress: one line each."""
+    from rlcore.trainers import dqn as dqn_trainer
+
+    monkeypatch.setitem(registry.EXPERIMENT_MODULES, "toy", "tests.toy")
+    spec = toy.spec("dqn", tmp_path, max_episodes=20, stop_score=99.0)
+    dqn_trainer.train(spec)
+    model = ["evaluate", "toy", "dqn", "--model", str(spec.run_dir)]
+    code, _, err = run(capsys, *model, "--episodes", "5", "--record")
+    assert code == 0, err
+    meta_path = spec.run_dir / "model" / "meta.json"
+    evaluation = json.loads(meta_path.read_text())["evaluation"]
+    assert evaluation["seeds"] == "10000..10004"
+    for seeds in ("10005..10007", "10008..10010"):
+        code, out, err = run(capsys, *model, "--episodes", "3", "--record-further")
+        assert code == 0 and "further evaluation (unseen seeds): greedy return" in out, err
+    meta = json.loads(meta_path.read_text())
+    assert meta["evaluation"] == evaluation
+    assert [ev["seeds"] for ev in meta["further_evaluations"]] == ["10005..10007", "10008..10010"]
+    assert all(len(ev["per_episode"]) == 3 and "machine" in ev for ev in meta["further_evaluations"])
+    for extra, message in ((["--seed-base", "10002"], "seeds 10002..10004 overlap those of an evaluation already "
+                                                      "recorded (10000..10004)"),
+                           (["--seed-base", "5"], "plays seeds 5..7, outside toy's unseen range 10000..1999999"),
+                           (["--record"], "give --record (the model's evaluation) or --record-further")):
+        code, _, err = run(capsys, *model, "--episodes", "3", "--record-further", *extra)
+        assert code == 2 and message in err and len(err.strip().splitlines()) == 1, err
+    assert json.loads(meta_path.read_text()) == meta  # nothing written by a refused command
+
+
 def test_the_installed_script_is_deeprl_and_says_its_version():
     """`pip install` puts the `deeprl` script and the packages in site-packages, no top-level `main`."""
     from importlib.metadata import distribution

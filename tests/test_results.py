@@ -58,7 +58,8 @@ def test_a_seed_summary_gives_the_iqm_each_seed_and_the_shipped_model_beside_the
     iqm, lo, hi = summarize([KEPT / "cartpole__dqn"], reps=5000)["sweeps"][0]["aggregates"]["iqm"]
     first = text.split("\n\n")[0]
     assert f"IQM [95% CI] **{iqm:.1f} [{lo:.1f}, {hi:.1f}]**" in first
-    assert "per seed " + ", ".join(f"{r['seed']}: {r['score']:.1f}" for r in runs) in first
+    assert "per seed " + "; ".join(f"{r['seed']}: {r['score']:.1f} over 100 after {r['env_steps']:,} env steps, "
+                                   f"{r['wall_seconds']:.0f} s" for r in runs) in first
     assert "the shipped model (seed 0, a run of its own) 500.0" in first
     assert first.endswith(stability_summary([r["story"] for r in runs]))
-    assert "not kept" in seed_summary("README.md", "no_such_experiment")
+    assert "Not kept" in seed_summary("README.md", "no_such_experiment")

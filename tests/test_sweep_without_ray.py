@@ -150,6 +150,66 @@ def test_report_tells_each_runs_collapses_and_which_weights_its_model_holds(tmp_
     assert "- seed=2: 1 collapse (3,000: 1.00 after 10.00, not recovered); model: the last weights" in text
 
 
+def _mario_run(folder: Path, seed: int, flags: int, further: int | None = None, **config) -> Path:
+    """A finished Mario 1-1 run folder as `main.py train mario_ppo ppo --seed S` leaves it, written by hand."""
+    (folder / "model").mkdir(parents=True)
+    meta = {"experiment": "mario_ppo", "algo": "ppo", "preset": "default", "seed": seed, "env_steps": 1000 * (seed + 1),
+            "wall_seconds": 10.0, "config": {"world": 1, "stage": 1, "lr": 1e-4, **config},
+            "evaluation": {"episodes": 10, "success_share": flags / 10, "seeds": "1000000..1000009"}}
+    if further is not None:
+        meta["further_evaluations"] = [{"episodes": 30, "success_share": further / 30, "seeds": "1000010..1000039"}]
+    (folder / "model" / "meta.json").write_text(json.dumps(meta))
+    (folder / "model" / "actor.h5").write_bytes(b"weights")
+    (folder / "metrics.csv").write_text("episode,env_steps,av_latest_points\n1,10,1.0\n2,1000,%s\n" % flags)
+    (folder / "rollouts.csv").write_text("rollout,env_steps\n1,1000\n")
+    (folder / "checkpoint.npz").write_bytes(b"large")
+    return folder
+
+
+def test_single_runs_over_seeds_are_kept_and_reported_as_a_sweep_of_their_level(tmp_path, capsys, monkeypatch):
+    """Mario 1-1's seeds are three `train` runs: `report RUN... --keep DIR` keeps them like a sweep (a budget
+    given again on a resume may differ), and the docs generator finds them as the sweep of level 1-1."""
+    from rlcore import docgen_data
+
+    runs = [str(_mario_run(tmp_path / "long_runs" / f"1-1-seed-{s}", s, flags, further, max_env_steps=budget))
+            for s, flags, further, budget in ((0, 9, 27, 10**7), (1, 10, None, 2 * 10**7), (2, 6, 20, 10**7))]
+    kept = tmp_path / "results" / "sweeps" / "mario_ppo__1-1"
+    code, out, err = run(capsys, "report", *runs, "--keep", str(kept), "--reps", "200")
+    assert code == 0, err
+    copied = sorted(str(p.relative_to(kept)) for p in kept.rglob("*") if p.is_file())
+    assert copied == sorted(["report.md", "report_curves.png", "sweep.json"]
+                            + [f"seed={s}/{name}" for s in range(3)
+                               for name in ("metrics.csv", "rollouts.csv", "model/meta.json")])
+    sweep = json.loads((kept / "sweep.json").read_text())
+    assert (sweep["seeds"], sweep["overrides"], sweep["preset"]) == ([0, 1, 2], {"world": 1, "stage": 1}, "default")
+    report = (kept / "report.md").read_text()
+    assert "| seed=2 | 2 | 0.600 |" in report and "| median | 0.900 |" in report
+    assert "- seed=0: 0.900 over 30 episodes" in report and "- seed=1: none" in report
+    monkeypatch.setattr(docgen_data, "REPO", tmp_path)
+    found = docgen_data.kept_sweeps()
+    assert list(found) == [("mario_ppo", "1-1")] and found[("mario_ppo", "1-1")].seeds == [(0, 0.9), (1, 1.0), (2, 0.6)]
+
+
+@pytest.mark.parametrize("case, message", [
+    ("no keep", "is a finished run, not a sweep: to report single runs of one recipe over seeds, keep them"),
+    ("other config", "differ in entropy_coef: kept runs are one recipe over seeds"),
+    ("same seed", "two of the runs have the same seed (0, 0)"),
+    ("with a sweep", "--keep takes one sweep folder, or finished run folders only, not both")])
+def test_single_runs_that_are_not_one_recipe_over_seeds_are_refused(tmp_path, capsys, case, message):
+    first = str(_mario_run(tmp_path / "a", 0, 9))
+    other = {"other config": lambda: _mario_run(tmp_path / "b", 1, 9, entropy_coef=0.003),
+             "same seed": lambda: _mario_run(tmp_path / "b", 0, 9)}.get(case, lambda: _mario_run(tmp_path / "b", 1, 9))()
+    argv = ["report", first, str(other), "--keep", str(tmp_path / "kept")]
+    if case == "no keep":
+        argv = argv[:-2]
+    if case == "with a sweep":
+        (tmp_path / "sweep").mkdir()
+        argv.insert(1, str(tmp_path / "sweep"))
+    code, _, err = run(capsys, *argv)
+    assert code == 2 and message in err and len(err.strip().splitlines()) == 1, err
+    assert not (tmp_path / "kept").exists()
+
+
 def test_report_refuses_a_folder_that_mixes_experiments_or_algorithms(tmp_path, capsys):
     """`report runs/` over a user's runs of unlike tasks would average unlike scores: one line, exit 2."""
     for name, experiment, algo, score in (("a", "lunar_lander", "dqn", 200.0), ("b", "cartpole", "a2c", 500.0),

@@ -1,0 +1,112 @@
+"""The figures of ``main.py report``: learning curves (the 100-episode average of each run's training
+episodes) and periodic evaluations over env steps, each an IQM over runs with its 95 % stratified bootstrap
+band (:func:`rlcore.report.stratified_bootstrap_ci`), every run drawn thin beside it. TensorFlow-free."""
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import numpy as np
+
+from rlcore.extras import require
+from rlcore.report import stratified_bootstrap_ci
+
+
+def run_curve(run_dir: Path) -> tuple[np.ndarray, np.ndarray]:
+    """One run's (env steps, 100-episode average return) at each episode's end, from metrics.csv."""
+    with open(Path(run_dir) / "metrics.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    return (np.array([float(r["env_steps"]) for r in rows]),
+            np.array([float(r["av_latest_points"]) for r in rows]))
+
+
+def learning_curve(run_dirs: list[Path], points: int = 40) -> tuple[np.ndarray, np.ndarray]:
+    """(env steps grid, [runs, points] 100-episode average return), each run interpolated.
+
+    The grid ends where the shortest run ends, so every point aggregates every run.
+    """
+    curves = [run_curve(d) for d in run_dirs]
+    end = min(s[-1] for s, _ in curves)
+    grid = np.linspace(0, end, points)
+    return grid, np.stack([np.interp(grid, s, v) for s, v in curves])
+
+
+
+def _iqm_band(curves: np.ndarray, reps: int) -> tuple[list, list, list]:
+    """IQM over runs at each column of a [runs, points] matrix, with its 95 % bootstrap interval."""
+    metrics = require("rliable.metrics", "A sweep report")  # the sweep extra
+    iqm, low, high = [], [], []
+    for j in range(curves.shape[1]):
+        point, ci = stratified_bootstrap_ci(metrics.aggregate_iqm, curves[:, j:j + 1], reps=reps)
+        iqm.append(float(point))
+        low.append(float(ci[0]))
+        high.append(float(ci[1]))
+    return iqm, low, high
+
+
+def _save_figure(fig, ax, ylabel: str, out: Path) -> Path:
+    import matplotlib.pyplot as plt
+
+    from rlcore.atomic import atomic_path
+
+    ax.set_xlabel("env steps")
+    ax.set_ylabel(ylabel)
+    ax.legend()
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    out = Path(out)
+    with atomic_path(out) as tmp:
+        fig.savefig(tmp, dpi=110)
+    plt.close(fig)
+    return out
+
+
+def _figure():
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt.subplots(figsize=(8, 4.5))
+
+
+def plot_curves(result: dict, out: Path, reps: int = 1000) -> Path:
+    """IQM of the 100-episode average return over env steps, with its 95 % CI band, per sweep.
+
+    The band covers the env steps every run reached; each run is also drawn in full, thin.
+    """
+    fig, ax = _figure()
+    for s in result["sweeps"]:
+        grid, curves = learning_curve([r["run_dir"] for r in s["runs"]])
+        iqm, low, high = _iqm_band(curves, reps)
+        line, = ax.plot(grid, iqm, lw=2, label=f"{s['label']}: IQM of {len(s['runs'])} runs, 95% CI")
+        ax.fill_between(grid, low, high, color=line.get_color(), alpha=0.25)
+        for r in s["runs"]:  # each run in full, since runs with an episode budget end at different steps
+            ax.plot(*run_curve(r["run_dir"]), color=line.get_color(), lw=0.7, alpha=0.35)
+    return _save_figure(fig, ax, "100-episode average return", out)
+
+
+def plot_evals(result: dict, out: Path, reps: int = 1000) -> Path | None:
+    """IQM of the periodic evaluations' mean return (selection seeds) over env steps, 95 % CI band, per
+    sweep; each run drawn thin. ``None`` (no file) when no run has periodic evaluations.
+
+    The band covers the evaluation steps every run reached; a collapse shows as one run's dip.
+    """
+    sweeps = [s for s in result["sweeps"] if all(r["story"].evaluations for r in s["runs"])]
+    if not sweeps:
+        return None
+    from rlcore.eval_history import read_evals
+
+    fig, ax = _figure()
+    for s in sweeps:
+        runs = [read_evals(r["run_dir"]) for r in s["runs"]]
+        steps = sorted(set.intersection(*({e.env_steps for e in evals} for evals in runs)))
+        line = None
+        if steps:
+            curves = np.array([[next(e.mean for e in evals if e.env_steps == x) for x in steps] for evals in runs])
+            iqm, low, high = _iqm_band(curves, reps)
+            line, = ax.plot(steps, iqm, lw=2, label=f"{s['label']}: IQM of {len(runs)} runs, 95% CI")
+            ax.fill_between(steps, low, high, color=line.get_color(), alpha=0.25)
+        for evals in runs:
+            ax.plot([e.env_steps for e in evals], [e.mean for e in evals], lw=0.7, alpha=0.45,
+                            color=line.get_color() if line else None)
+    return _save_figure(fig, ax, "periodic evaluation, mean return", out)
