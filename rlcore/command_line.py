@@ -193,8 +193,8 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
                              "folders of one recipe over seeds (main.py train ... --seed S) may be given instead")
     report.add_argument("--reps", type=whole_number(Allowed(low=100, high=10**6)), default=5000, help="bootstrap resamples")
     report.add_argument("--keep", metavar="DIR", default=None,
-                        help="first copy sweep.json and, per run, model/meta.json and its CSV tables "
-                             "(not the checkpoints) into DIR, a folder git keeps such as "
+                        help="first copy sweep.json and, per run, model/meta.json, the model's .h5 files and "
+                             "its CSV tables (not the checkpoints) into DIR, a folder git keeps such as "
                              "results/sweeps/NAME, and write the report there; run folders go to DIR/seed=S "
                              "with a sweep.json written for them")
 

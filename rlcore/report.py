@@ -99,8 +99,17 @@ def load_runs(sweep_dir: Path) -> list[dict]:
 
 
 #: what ``keep`` copies of a run folder: what the report reads (meta.json, metrics.csv), the periodic
-#: evaluations (evals.csv) and PPO's rollout table (rollouts.csv); checkpoints and models stay behind
-KEPT_FILES = ("model/meta.json", "metrics.csv", "evals.csv", "rollouts.csv")
+#: evaluations (evals.csv), PPO's rollout table (rollouts.csv) and the model's weights (model/*.h5), so
+#: that a kept run's model can be evaluated again (``main.py evaluate ... --model KEPT/seed=S``);
+#: checkpoints, replay memories and plots stay behind
+KEPT_FILES = ("model/meta.json", "model/*.h5", "metrics.csv", "evals.csv", "rollouts.csv")
+
+
+def kept_files(run_dir: Path) -> list[str]:
+    """The :data:`KEPT_FILES` a run folder holds, as paths relative to it."""
+    run_dir = Path(run_dir)
+    return [p.relative_to(run_dir).as_posix() for pattern in KEPT_FILES for p in sorted(run_dir.glob(pattern))
+            if p.is_file()]
 
 
 def is_run_folder(folder: Path) -> bool:
@@ -149,7 +158,7 @@ def keep_runs(run_dirs: list[Path], dest: Path) -> Path:
              "seeds": sorted(seeds), "grid": {}, "preset": first.get("preset"),
              "overrides": {f: first["config"][f] for f in fields}}
     pairs = [(d / name, dest / f"seed={meta['seed']}" / name) for d, meta in zip(run_dirs, metas)
-             for name in KEPT_FILES if (d / name).is_file()]
+             for name in kept_files(d)]
     _copy(pairs)
     write_atomic(dest / "sweep.json", lambda tmp: tmp.write_text(json.dumps(sweep, indent=2) + "\n"))
     return dest
@@ -163,8 +172,7 @@ def keep(sweep_dir: Path, dest: Path) -> Path:
     runs = load_runs(sweep_dir)  # refuses a folder with no finished run before anything is copied
     copies = [(sweep_dir / "sweep.json", dest / "sweep.json")] if (sweep_dir / "sweep.json").is_file() else []
     for run in runs:
-        copies += [(run["run_dir"] / name, dest / run["trial"] / name) for name in KEPT_FILES
-                   if (run["run_dir"] / name).is_file()]
+        copies += [(run["run_dir"] / name, dest / run["trial"] / name) for name in kept_files(run["run_dir"])]
     _copy(copies)
     return dest
 

@@ -1,6 +1,7 @@
 """The README's "IQM [95% CI] over 5 seeds" figures are recomputed from the sweep results git keeps
 (`results/sweeps/NAME`, written by `main.py report SWEEP --keep`), so a figure cannot drift from its
 runs, and the runs cannot go missing from a clone."""
+import numpy as np
 import pytest
 
 from rlcore.report import load_runs, summarize
@@ -63,3 +64,35 @@ def test_a_seed_summary_gives_the_iqm_each_seed_and_the_shipped_model_beside_the
     assert "the shipped model (seed 0, a run of its own) 500.0" in first
     assert first.endswith(stability_summary([r["story"] for r in runs]))
     assert "Not kept" in seed_summary("README.md", "no_such_experiment")
+
+
+def kept_models() -> list[str]:
+    """The kept runs that kept their model's weights (model/*.h5), as "sweep/seed=S"."""
+    return sorted(f"{p.parent.parent.parent.name}/{p.parent.parent.name}" for p in KEPT.glob("*/*/model/meta.json")
+                  if any(p.parent.glob("*.h5")))
+
+
+@pytest.mark.parametrize("run", kept_models())
+def test_a_kept_runs_model_plays_its_recorded_first_episode_again(run):
+    """Held-out checks replay a kept run's model. On the machine that recorded its evaluation the first
+    recorded episode repeats exactly (rlcore.machine); elsewhere it plays that seed to its end (oneDNN may
+    take another course on another CPU, and a seed of a sweep need not clear the shipped model's bar)."""
+    from rlcore import machine
+    from rlcore.evaluation import evaluate, evaluate_success
+    from rlcore.policies import load_policy
+
+    exp, meta, policy = load_policy(KEPT / run / "model")
+    first = meta["evaluation"]["per_episode"][0]
+    assert first["seed"] == exp.eval_seed_base
+    exact = machine.replays_exactly(machine.recorded_machine(meta))
+    if goal := exp.goal:
+        [got] = evaluate_success(policy.make_env, policy.sample, 1, exp.eval_seed_base, goal.success_key,
+                                 goal.progress_key, progress=False)
+        if exact:
+            assert (got["success"], got["length"], got[goal.progress_key]) == (
+                first["success"], first["length"], first[goal.progress_key])
+        return
+    [got] = evaluate(exp, policy, episodes=1, progress=False, make_env=policy.make_env)
+    assert np.isfinite(got)
+    if exact:
+        assert got == pytest.approx(first["return"], rel=1e-5)

@@ -99,7 +99,7 @@ def test_report_groups_a_grid_sweep_by_setting(tmp_path):
     assert f"| median | 487.000 | [{lo:.3f}, {hi:.3f}] |" in text and "| mean | 380.400 |" in text
 
 
-def test_report_keep_copies_what_the_report_reads_and_nothing_else(tmp_path, capsys):
+def test_report_keep_copies_what_the_report_reads_and_the_model_and_nothing_else(tmp_path, capsys):
     sweep, kept = tmp_path / "sweeps" / "toy__dqn", tmp_path / "results" / "toy__dqn"
     (sweep).mkdir(parents=True)
     (sweep / "sweep.json").write_text(json.dumps({"experiment": "toy"}))
@@ -112,10 +112,12 @@ def test_report_keep_copies_what_the_report_reads_and_nothing_else(tmp_path, cap
         (run_dir / "evals.csv").write_text("env_steps,episode,eval_mean,eval_std,eval_time_limit_share\n"
                                            "1000,2,%s,1.0,0.0\n" % score)
         (run_dir / "checkpoint.npz").write_bytes(b"large")
+        (run_dir / "model" / "q_network.h5").write_bytes(b"weights")
+        (run_dir / "model" / "toy_Train_dqn.png").write_bytes(b"plot")
     code, out, err = run(capsys, "report", str(sweep), "--keep", str(kept), "--reps", "200")
     assert code == 0, err
     copied = sorted(str(p.relative_to(kept)) for p in kept.rglob("*") if p.is_file())
-    per_run = ["evals.csv", "metrics.csv", "model/meta.json"]
+    per_run = ["evals.csv", "metrics.csv", "model/meta.json", "model/q_network.h5"]
     assert copied == sorted(["report.md", "report_curves.png", "report_evals.png", "sweep.json"]
                             + [f"seed={s}/{name}" for s in range(3) for name in per_run])
     assert not (sweep / "report.md").exists()  # the report is written where the copies are
@@ -179,7 +181,7 @@ def test_single_runs_over_seeds_are_kept_and_reported_as_a_sweep_of_their_level(
     copied = sorted(str(p.relative_to(kept)) for p in kept.rglob("*") if p.is_file())
     assert copied == sorted(["report.md", "report_curves.png", "sweep.json"]
                             + [f"seed={s}/{name}" for s in range(3)
-                               for name in ("metrics.csv", "rollouts.csv", "model/meta.json")])
+                               for name in ("metrics.csv", "rollouts.csv", "model/meta.json", "model/actor.h5")])
     sweep = json.loads((kept / "sweep.json").read_text())
     assert (sweep["seeds"], sweep["overrides"], sweep["preset"]) == ([0, 1, 2], {"world": 1, "stage": 1}, "default")
     report = (kept / "report.md").read_text()
