@@ -224,7 +224,8 @@ def test_every_algorithm_builds_its_train_parser(capsys):
                 assert args.algo == algo
 
 
-@pytest.mark.parametrize("script", ["lunar_lander.py", "cartpole.py", "mario.py", "minitaur.py", "sweep.py"])
+@pytest.mark.parametrize("script", ["lunar_lander.py", "cartpole.py", "mario.py", "minitaur.py", "minitaur_concurrency.py",
+                                    "sweep.py"])
 def test_benchmark_scripts_start(script):
     """Imports and --help only: the measurements themselves are not tests."""
     done = subprocess.run([sys.executable, str(ROOT / "benchmarks" / script), "--help"], cwd=ROOT,
