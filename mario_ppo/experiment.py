@@ -177,7 +177,7 @@ EXPERIMENT = Experiment(
                     "restart_back_step", "restart_goal_x", "restart_back_share"),
         partial_key="restarted", partial_start_key="start_x",
         memory="restart_routes", share_memory=lend_routes),
-    shipped_by=ShippedBy(fields=("world", "stage"), default="1-1"),  # saved_networks/mario_ppo/1-1
+    shipped_by=ShippedBy(fields=("world", "stage"), default="1-1", noun="level"),  # saved_networks/mario_ppo/1-1
 )
 
 extras.declare("mario_ppo", "Mario", "mario", ("cv2", "nes_py", "gym_super_mario_bros"))  # checked early

@@ -90,29 +90,56 @@ def cmd_train(args) -> int:
     return 0
 
 
+def _shipped_choice(args) -> dict:
+    """The shipped-model fields given on the command line (Mario: ``{"world": 1}`` for ``--world 1``)."""
+    from rlcore.command_line import shipped_by_options
+
+    return {name: getattr(args, name) for name in shipped_by_options() if getattr(args, name, None) is not None}
+
+
+def _flags(names) -> str:
+    return "/".join(f"--{name.replace('_', '-')}" for name in names)
+
+
 def _model_dir(args) -> Path:
-    """--model, else the shipped model (for Mario, that of --world/--stage, default 1-1)."""
+    """--model, else the shipped model (where an experiment ships one per value of some fields, that of
+    the values given: Mario's --world/--stage, default 1-1)."""
     from rlcore.experiment import get_experiment
 
     exp = get_experiment(args.experiment)
     exp.algo(args.algo)  # unknown names -> clear error
-    level = (args.world, args.stage)
-    if level == (None, None) and args.model:
+    given = _shipped_choice(args)
+    if not given and args.model:
         folder = Path(args.model)
         finished = folder / "model"  # a finished run's folder: its model
         return finished if (finished / "meta.json").is_file() and not (folder / "meta.json").is_file() else folder
-    if level == (None, None):
+    if not given:
         return shipping.require_shipped(shipping.shipped_dir(args.experiment, args.algo),
                                         f"{args.experiment} {args.algo}")
-    if exp.shipped_by is None:
-        raise UserError(f"--world/--stage choose a Mario level; {exp.name} ships one model per algorithm")
-    if args.model:
-        raise UserError("give either --model or --world/--stage, not both")
-    from types import SimpleNamespace
+    if exp.shipped_by is None or set(given) - set(exp.shipped_by.fields):
+        from rlcore.experiment import experiment_names
 
-    folder = shipping.shipped_dir(exp.name, args.algo, SimpleNamespace(world=args.world or 1,
-                                                                       stage=args.stage or 1))
-    return shipping.require_shipped(folder, f"for level {folder.name}")
+        owners = [name for name in experiment_names() if (by := get_experiment(name).shipped_by)
+                  and set(given) <= set(by.fields)]
+        raise UserError(f"{_flags(given)} choose{'s' if len(given) == 1 else ''} among the shipped models of "
+                        f"{', '.join(owners)}; {exp.name} ships one model per "
+                        + (f"{exp.shipped_by.noun} ({_flags(exp.shipped_by.fields)})" if exp.shipped_by else "algorithm"))
+    if args.model:
+        raise UserError(f"give either --model or {_flags(exp.shipped_by.fields)}, not both")
+    folder = shipping.models_root() / exp.name / exp.shipped_by.folder_from(given)
+    return shipping.require_shipped(folder, f"for {exp.shipped_by.noun} {folder.name}")
+
+
+def _output_name(args) -> str:
+    """``mario_ppo_ppo_1-1`` for the shipped model chosen by its fields, else ``EXPERIMENT_ALGO``."""
+    from rlcore.experiment import get_experiment
+    from rlcore.trainers.spec import folder_safe
+
+    name = f"{folder_safe(args.experiment)}_{args.algo}"
+    shipped_by = get_experiment(args.experiment).shipped_by
+    if shipped_by and _shipped_choice(args):
+        name += f"_{shipped_by.folder_from(_shipped_choice(args))}"
+    return name
 
 
 @contextlib.contextmanager
@@ -171,11 +198,7 @@ def _render(model_dir: Path, out: Path, fps: int | None, episodes: int | None, s
 def cmd_render(args) -> int:
     from rlcore.policies import load_policy
 
-    from rlcore.trainers.spec import folder_safe
-
-    name = f"{folder_safe(args.experiment)}_{args.algo}"
-    if args.world or args.stage:
-        name += f"_{args.world or 1}-{args.stage or 1}"
+    name = _output_name(args)
     out = Path(args.out) if args.out else Path("videos") / f"{name}.mp4"
     if out.is_dir():
         out = out / f"{name}.mp4"
@@ -191,11 +214,7 @@ def cmd_render(args) -> int:
 def cmd_export(args) -> int:
     from rlcore.export import export_model, summary
 
-    from rlcore.trainers.spec import folder_safe
-
-    name = f"{folder_safe(args.experiment)}_{args.algo}"
-    if args.world or args.stage:
-        name += f"_{args.world or 1}-{args.stage or 1}"
+    name = _output_name(args)
     out = Path(args.out) if args.out else Path("exports") / f"{name}_{args.format}"
     with _model(args) as (model_dir, source):
         record = export_model(model_dir, args.format, out, observations=args.observations, source=source,

@@ -7,8 +7,8 @@ TensorFlow-free, so `--help` is quick.
 from __future__ import annotations
 
 import argparse
+import functools
 
-from mario_ppo.levels import STAGE, WORLD
 from rlcore import allowed
 from rlcore.allowed import Allowed, whole_number
 from rlcore.seeding import MAX_EVAL_EPISODES, MAX_RUN_SEED
@@ -233,18 +233,41 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
 
 
 def _add_model_choice(p: argparse.ArgumentParser, experiments: list[str]) -> None:
-    """EXPERIMENT ALGO and which of its models: --model, or Mario's --world/--stage (evaluate, render,
-    export)."""
+    """EXPERIMENT ALGO and which of its models: --model, or the fields that choose a shipped model where an
+    experiment ships one per value of them (Mario's --world/--stage; evaluate, render, export)."""
     p.add_argument("experiment", help=f"one of {', '.join(experiments)}, or the Gymnasium id a --model was "
                                       "trained on")
     p.add_argument("algo", help="an algorithm of the experiment (`list` shows them)")
     p.add_argument("--model", default=None,
                    help="model folder, a finished run's folder, or a run in progress (its last "
                         "checkpoint) (default saved_networks/EXPERIMENT/ALGO)")
-    p.add_argument("--world", type=whole_number(WORLD), default=None,
-                   help="Mario: the shipped model of this world (default 1)")
-    p.add_argument("--stage", type=whole_number(STAGE), default=None,
-                   help="Mario: the shipped model of this stage (default 1)")
+    for name, (parse, text) in shipped_by_options().items():
+        p.add_argument(f"--{name.replace('_', '-')}", dest=name, type=parse, default=None, help=text)
+
+
+@functools.cache
+def shipped_by_options() -> dict[str, tuple]:
+    """field -> (parse, help) of the config fields that choose a shipped model, for every registered
+    experiment that ships one model per value of some fields (``Experiment.shipped_by``; Mario: world and
+    stage -> ``--world``, ``--stage``). Parsed with the field's type and checked against its allowed values."""
+    import dataclasses
+
+    from rlcore.experiment import experiment_names, get_experiment
+    from rlcore.hparams import field_types
+
+    options: dict[str, tuple] = {}
+    for name in experiment_names():
+        exp = get_experiment(name)
+        if exp.shipped_by is None:
+            continue
+        config = exp.preset(next(iter(exp.algos)), None)
+        fields = {f.name: f for f in dataclasses.fields(config)}
+        types = field_types(type(config))
+        for field_name, default in exp.shipped_by.default_values().items():
+            allowed = fields[field_name].metadata.get("allowed")
+            parse = whole_number(allowed) if types[field_name] is int and allowed is not None else types[field_name]
+            options.setdefault(field_name, (parse, f"{name}: the shipped model of this {field_name} (default {default})"))
+    return options
 
 
 class _Unparsable(Exception):

@@ -117,6 +117,7 @@ class ShippedBy:
     not one per algorithm: saved_networks/EXPERIMENT/<the values joined by '-'>."""
     fields: tuple[str, ...]  # the config fields (Mario: world, stage -> saved_networks/mario_ppo/1-1)
     default: str  # the folder evaluate/render/load take when no value is given (Mario: 1-1)
+    noun: str = "model"  # what one such model is, for messages (Mario: level)
 
     def __post_init__(self) -> None:
         if not self.fields:
@@ -125,6 +126,15 @@ class ShippedBy:
     def folder(self, values) -> str:
         """The model folder's name for a config (or any object with the fields as attributes)."""
         return "-".join(str(getattr(values, name)) for name in self.fields)
+
+    def default_values(self) -> dict[str, str]:
+        """Each field's value in the default folder (Mario: ``{"world": "1", "stage": "1"}``)."""
+        return dict(zip(self.fields, self.default.split("-")))
+
+    def folder_from(self, given: dict) -> str:
+        """The folder of the values given on a command line (``None``: the default folder's value)."""
+        defaults = self.default_values()
+        return "-".join(str(defaults[f] if given.get(f) is None else given[f]) for f in self.fields)
 
 
 @dataclass(frozen=True)

@@ -56,7 +56,8 @@ def dqn_model_dir(tmp_path):
     (["plot", "/nonexistent/run"], "no metrics.csv in /nonexistent/run"),
     (["evaluate", "mario_ppo", "ppo", "--world", "8", "--stage", "4"], "no shipped model for level 8-4 in "),
     (["evaluate", "CartPole-v1", "dqn"], "no shipped model CartPole-v1 dqn in "),
-    (["render", "lunar_lander", "dqn", "--world", "1"], "--world/--stage choose a Mario level"),
+    (["render", "lunar_lander", "dqn", "--world", "1"], "--world chooses among the shipped models of mario_ppo; "
+                                                        "lunar_lander ships one model per algorithm"),
     (["evaluate", "mario_ppo", "ppo", "--world", "1", "--model", "x"], "either --model or --world/--stage"),
     (["evaluate", "mario_ppo", "ppo", "--stage", "0"], "argument --stage: 0 is invalid: allowed is a number "
                                                        "from 1 to 4"),
@@ -301,6 +302,48 @@ def test_a_further_evaluation_plays_the_next_unseen_seeds_and_keeps_the_evaluati
         code, _, err = run(capsys, *model, "--episodes", "3", "--record-further", *extra)
         assert code == 2 and message in err and len(err.strip().splitlines()) == 1, err
     assert json.loads(meta_path.read_text()) == meta  # nothing written by a refused command
+
+
+def test_the_flags_that_choose_a_shipped_model_come_from_the_registry(capsys, monkeypatch, tmp_path):
+    """An experiment that ships one model per value of a config field (Mario: world, stage) gets that
+    field as a flag of evaluate/render/export, parsed and checked as the field is; nothing names Mario."""
+    import dataclasses
+    import types
+
+    from rlcore.command_line import shipped_by_options
+    from rlcore.experiment import ShippedBy
+
+    module = types.ModuleType("tests.toy_sized")
+    module.EXPERIMENT = dataclasses.replace(toy.EXPERIMENT, name="toy_sized",
+                                            shipped_by=ShippedBy(fields=("batch_size",), default="32", noun="size"))
+    monkeypatch.setitem(sys.modules, "tests.toy_sized", module)
+    monkeypatch.setitem(registry.EXPERIMENT_MODULES, "toy_sized", "tests.toy_sized")
+    monkeypatch.setitem(registry.EXPERIMENT_MODULES, "toy", "tests.toy")
+    monkeypatch.setenv("DEEPRL_MODELS", str(tmp_path))
+    shipped_by_options.cache_clear()
+    try:
+        code, out, _ = run(capsys, "evaluate", "--help")
+        assert code == 0 and "toy_sized: the shipped model of this batch_size (default 32)" in " ".join(out.split())
+        code, _, err = run(capsys, "evaluate", "toy_sized", "dqn", "--batch-size", "64")
+        assert code == 2 and f"no shipped model for size 64 in {tmp_path / 'toy_sized'}" in err
+        code, _, err = run(capsys, "render", "toy_sized", "dqn", "--batch-size", "0")
+        assert code == 2 and "argument --batch-size: 0 is invalid" in err
+        code, _, err = run(capsys, "evaluate", "toy", "dqn", "--batch-size", "64")
+        assert code == 2 and "--batch-size chooses among the shipped models of toy_sized; toy ships one model per algorithm" in err
+        code, _, err = run(capsys, "evaluate", "toy_sized", "dqn", "--world", "2")
+        assert code == 2 and ("--world chooses among the shipped models of mario_ppo; toy_sized ships one model "
+                              "per size (--batch-size)") in err
+    finally:
+        shipped_by_options.cache_clear()
+
+
+def test_a_shipped_by_folder_fills_the_values_not_given_from_its_default():
+    from rlcore.experiment import ShippedBy
+
+    by = ShippedBy(fields=("world", "stage"), default="1-1", noun="level")
+    assert by.default_values() == {"world": "1", "stage": "1"}
+    assert [by.folder_from(given) for given in ({"world": 2}, {"stage": 4}, {"world": 8, "stage": 3}, {})] == [
+        "2-1", "1-4", "8-3", "1-1"]
 
 
 def test_the_installed_script_is_deeprl_and_says_its_version():
