@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import gymnasium as gym
 
-from mario_ppo.env import DEATH_PENALTY
+from mario_ppo.rewards import DEATH_PENALTY
 
 # A fall of x larger than this in one agent step is a pipe into another area, not running: Mario
 # runs at most 12 pixels an agent step of 4 frames (measured: right + B on 1-1).

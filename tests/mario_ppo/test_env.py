@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from mario_ppo.deaths import KilledBy
-from mario_ppo.env import FRAME_SIZE, ClassicReward, SkipAndHistory, SkipAndStack, classic_reward, gray_84, make_env
+from mario_ppo.env import FRAME_SIZE, SkipAndHistory, SkipAndStack, gray_84, make_env
+from mario_ppo.rewards import ClassicReward, classic_reward
 from mario_ppo.episode_ends import DeadEnds, StallLimit
 from rlcore.errors import UserError
 from tests.mario_ppo.scripted import ScriptedInfos
