@@ -72,3 +72,34 @@ def write_atomic(target: str | os.PathLike, writer: Callable[[Path], None]) -> N
 def write_json(target: str | os.PathLike, data: dict) -> None:
     """Write ``data`` as indented JSON, atomically."""
     write_atomic(target, lambda p: p.write_text(json.dumps(data, indent=2, default=str) + "\n"))
+
+
+def replace_folder(target: str | os.PathLike, fill: Callable[[Path], None]) -> Path:
+    """Make ``target`` a folder holding exactly what ``fill(new_folder)`` writes, replacing it whole.
+
+    The new folder is built beside the target, then swapped in with two renames: a crash leaves either
+    the old folder or the new one in place (plus at most a hidden ``.NAME.old-*`` / ``.NAME.new-*``
+    folder to delete), never a mix; files of the old folder that the new one lacks do not survive. A
+    full disk or an unwritable folder is a :class:`WriteFailed` naming ``target``."""
+    import shutil
+
+    target = Path(target)
+    fresh = None
+    try:
+        target.parent.mkdir(parents=True, exist_ok=True)
+        fresh = Path(tempfile.mkdtemp(prefix=f".{target.name}.new-", dir=target.parent))
+        fill(fresh)
+        os.chmod(fresh, 0o755)
+        if target.exists():
+            old = Path(tempfile.mkdtemp(prefix=f".{target.name}.old-", dir=target.parent))
+            os.replace(target, old / target.name)
+            os.replace(fresh, target)
+            shutil.rmtree(old)
+        else:
+            os.replace(fresh, target)
+    except OSError as exc:
+        raise WriteFailed(target, exc) from None
+    finally:
+        if fresh is not None and fresh.exists():
+            shutil.rmtree(fresh, ignore_errors=True)
+    return target

@@ -168,16 +168,14 @@ def cmd_evaluate(args) -> int:
     if args.record and args.record_further:
         raise UserError("give --record (the model's evaluation) or --record-further (one more), not both")
     with _model(args) as (model_dir, name):
+        if args.record or args.record_further:  # seeds checked before the model loads; it must match the names
+            record = shipping.evaluate_further_into_meta if args.record_further else shipping.evaluate_into_meta
+            episodes = shipping.eval_episodes(shipping.experiment_of(model_dir), args.episodes)
+            record(model_dir, episodes, args.seed_base, args.experiment, args.algo)
+            print(f"recorded in {model_dir / 'meta.json'}" + (" (further_evaluations)" if args.record_further else ""))
+            return 0
         exp, meta, policy = load_policy(model_dir, args.experiment, args.algo)
         episodes = shipping.eval_episodes(exp, args.episodes)
-        if args.record_further:
-            shipping.evaluate_further_into_meta(model_dir, episodes, args.seed_base)
-            print(f"recorded in {model_dir / 'meta.json'} (further_evaluations)")
-            return 0
-        if args.record:
-            shipping.evaluate_into_meta(model_dir, episodes, args.seed_base)
-            print(f"recorded in {model_dir / 'meta.json'}")
-            return 0
         _, line = shipping.run_evaluation(exp, policy, episodes, args.seed_base)
     print(f"{exp.name} {args.algo} ({name}): {line}")
     return 0

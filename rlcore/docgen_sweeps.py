@@ -36,6 +36,10 @@ def sweep_stability(page: str, experiment: str) -> str:
         if m.experiment != experiment or m.sweep is None:
             continue
         runs = _runs(m.sweep.folder)
+        if not any(st.evaluations for _, st in runs):
+            parts.append(f"**[{m.name}]({link(page, m.sweep.folder + '/report.md')})**: its runs made no periodic "
+                         f"evaluations; each model holds its run's last weights.")
+            continue
         rows = []
         for meta, st in runs:
             ev = meta.get("evaluation") or {}
@@ -74,8 +78,9 @@ def seed_summary(page: str, experiment: str) -> str:
         parts.append(f"{m.title}, the same recipe over {len(m.sweep.seeds)} seeds "
                      f"([report]({link(page, m.sweep.folder + '/report.md')})): IQM [95% CI] **{iqm_text(m)}**; "
                      f"per seed {per_seed}; the shipped model (seed {m.meta.get('seed')}, a run of its own) "
-                     f"{score_text(m)}. "
-                     f"During training {stability_summary([st for _, st in runs])}")
+                     f"{score_text(m)}."
+                     + (f" During training {stability_summary([st for _, st in runs])}"
+                        if any(st.evaluations for _, st in runs) else ""))
     if not parts:
         return "*Not kept in `results/sweeps/` yet: the figures appear here when the runs are.*"
     return "\n\n".join(parts)

@@ -17,6 +17,7 @@ Seed 0 of the Minitaur sweep, for instance: its first evaluation -0.08, then 14.
 from __future__ import annotations
 
 import csv
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -48,11 +49,14 @@ def read_evals(run_dir: Path) -> list[Evaluation]:
     try:
         with open(path, newline="") as f:
             rows = list(csv.DictReader(f))
-        return [Evaluation(int(float(r["env_steps"])), float(r["eval_mean"]),
-                           float(r["eval_time_limit_share"]) if r.get("eval_time_limit_share") not in (None, "")
-                           else None) for r in rows]
+        evals = [Evaluation(int(float(r["env_steps"])), float(r["eval_mean"]),
+                            float(r["eval_time_limit_share"]) if r.get("eval_time_limit_share") not in (None, "")
+                            else None) for r in rows]
     except (KeyError, ValueError, TypeError, UnicodeDecodeError) as exc:
         raise UserError(f"{path} is damaged or not one of ours ({type(exc).__name__})") from None
+    if not all(math.isfinite(e.mean) for e in evals):
+        raise UserError(f"{path} is damaged or not one of ours (an evaluation's mean is not a number)")
+    return evals
 
 
 def collapses(evals: list[Evaluation], drop: float = DROP, recover: float = RECOVER,
@@ -92,22 +96,25 @@ class Story:
     kept_best: bool  # the model holds the best evaluation's weights (keep_best), not the last ones
 
     @property
-    def shielded(self) -> bool:
+    def keep_best_mattered(self) -> bool:
         """keep-best kept weights that evaluated better than the last ones."""
         return self.kept_best and self.best is not None and self.last is not None and self.best.mean > self.last.mean
 
 
 def story(run_dir: Path, meta: dict) -> Story:
-    """A run folder's :class:`Story`, from its ``evals.csv`` and its model's ``meta.json``."""
+    """A run folder's :class:`Story`, from its ``evals.csv`` and its model's ``meta.json``. The best
+    evaluation is the one training remembered (``best_eval``), else the highest (a tie: the later)."""
     evals = read_evals(run_dir)
     best = max(reversed(evals), key=lambda e: e.mean) if evals else None  # a tie goes to the later one
+    remembered = (meta.get("best_eval") or {}).get("env_steps")
+    best = next((e for e in evals if e.env_steps == remembered), best)
     return Story(len(evals), best, evals[-1] if evals else None, collapses(evals),
                  meta.get("weights") == "best periodic evaluation")
 
 
 def steps_text(env_steps: int) -> str:
     """1,000,062 -> "1M"; 1,950,000 -> "1.95M"; 650,000 -> "650k"; 1,234 -> "1,234"."""
-    if env_steps >= 1_000_000:
+    if env_steps >= 999_500:
         return f"{round(env_steps / 1e6, 2):g}M"
     if env_steps >= 10_000:
         return f"{round(env_steps / 1000):,}k"
@@ -127,7 +134,7 @@ def story_text(s: Story, digits: int = 2) -> str:
              + (f" ({'; '.join(collapse_text(c, digits) for c in s.collapses)})" if s.collapses else "")]
     if s.kept_best and s.best is not None:
         parts.append(f"model: weights of the best evaluation ({s.best.mean:.{digits}f} at {steps_text(s.best.env_steps)})"
-                     + (f", the last scored {s.last.mean:.{digits}f}" if s.shielded else ", also the last"))
+                     + (f", the last scored {s.last.mean:.{digits}f}" if s.keep_best_mattered else ", also the last"))
     else:
         parts.append("model: the last weights")
     return "; ".join(parts)
@@ -139,7 +146,10 @@ def stability_summary(stories: list[Story]) -> str:
     collapsed = sum(bool(st.collapses) for st in stories)
     count = sum(len(st.collapses) for st in stories)
     unrecovered = sum(c.recovered_at is None for st in stories for c in st.collapses)
-    shielded = sum(st.shielded for st in stories)
+    mattered = sum(st.keep_best_mattered for st in stories)
+    weights = ("keep-best changed no model (each model's weights scored as high as its run's last evaluation)"
+               if not mattered else
+               f"in {mattered} run{'' if mattered == 1 else 's'} keep-best mattered: the model holds an earlier "
+               f"evaluation's weights, which scored above the run's last evaluation")
     return (f"{collapsed} of {len(stories)} runs collapsed at least once ({count} collapse{'' if count == 1 else 's'}, "
-            f"{unrecovered} not recovered); in {shielded} run{'' if shielded == 1 else 's'} keep-best mattered: the "
-            f"model holds an earlier evaluation's weights, which scored above the run's last evaluation.")
+            f"{unrecovered} not recovered); {weights}.")

@@ -18,7 +18,6 @@ from pathlib import Path
 
 import numpy as np
 
-from rlcore.atomic import write_atomic
 from rlcore.errors import UserError
 from rlcore.eval_history import stability_summary, story, story_text
 from rlcore.extras import require
@@ -117,10 +116,28 @@ def is_run_folder(folder: Path) -> bool:
     return (Path(folder) / "model" / "meta.json").is_file()
 
 
-def _copy(pairs: list[tuple[Path, Path]]) -> None:
-    for source, target in pairs:
-        target.parent.mkdir(parents=True, exist_ok=True)
-        write_atomic(target, lambda tmp, source=source: shutil.copyfile(source, tmp))
+def _keep_into(dest: Path, pairs: list[tuple[Path, str]], sweep: dict | None = None) -> Path:
+    """Make ``dest`` hold exactly the ``pairs`` (source file, path in ``dest``) and, given, ``sweep`` as
+    its sweep.json; an earlier kept sweep there is replaced whole (a seed it held and this keep lacks
+    does not survive), in one swap (:func:`rlcore.atomic.replace_folder`), so a kept folder is never a
+    mix of two keeps or a keep cut short."""
+    from rlcore.atomic import replace_folder
+
+    if dest.exists() and not dest.is_dir():
+        raise UserError(f"--keep {dest}: a file is there; give a folder")
+    earlier_keep = (dest / "sweep.json").is_file() or any(dest.glob("*/model/meta.json"))
+    if dest.is_dir() and any(dest.iterdir()) and not earlier_keep:
+        raise UserError(f"--keep {dest}: that folder holds other files and no kept sweep (sweep.json); give a new "
+                        f"folder, or one an earlier keep wrote, which is replaced whole")
+
+    def fill(fresh: Path) -> None:
+        for source, name in pairs:
+            (fresh / name).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copyfile(source, fresh / name)
+        if sweep is not None:
+            (fresh / "sweep.json").write_text(json.dumps(sweep, indent=2) + "\n")
+
+    return replace_folder(dest, fill)
 
 
 #: config fields kept runs may differ in: budgets, which a resume may give again (the stop rule ends a run)
@@ -133,6 +150,7 @@ def keep_runs(run_dirs: list[Path], dest: Path) -> Path:
     the experiment, algorithm, preset, seeds and (for Mario) the level, so that ``report`` and the docs
     generator read ``dest`` like any kept sweep. The runs must differ in their seed (and :data:`BUDGETS`) only."""
     from rlcore.experiment import get_experiment
+    from rlcore.hparams import to_dict
 
     run_dirs, dest = [Path(d) for d in run_dirs], Path(dest)
     metas = [json.loads((d / "model" / "meta.json").read_text()) for d in run_dirs]
@@ -154,14 +172,14 @@ def keep_runs(run_dirs: list[Path], dest: Path) -> Path:
                         "(main.py evaluate ... --model RUN_DIR --record)")
     exp = get_experiment(first["experiment"])
     fields = exp.shipped_by.fields if exp.shipped_by else ()
+    preset = json.loads(json.dumps(to_dict(exp.preset(first["algo"], first.get("preset")))))  # as meta.json has it
     sweep = {"experiment": first["experiment"], "algo": first["algo"], "name": dest.name, "folder": str(dest.resolve()),
              "seeds": sorted(seeds), "grid": {}, "preset": first.get("preset"),
-             "overrides": {f: first["config"][f] for f in fields}}
-    pairs = [(d / name, dest / f"seed={meta['seed']}" / name) for d, meta in zip(run_dirs, metas)
-             for name in kept_files(d)]
-    _copy(pairs)
-    write_atomic(dest / "sweep.json", lambda tmp: tmp.write_text(json.dumps(sweep, indent=2) + "\n"))
-    return dest
+             # what the recipe set beside its preset (Mario: the level, the stop share, the precision)
+             "overrides": {k: v for k, v in first["config"].items()
+                           if k in fields or (k not in BUDGETS and preset.get(k) != v)}}
+    pairs = [(d / name, f"seed={meta['seed']}/{name}") for d, meta in zip(run_dirs, metas) for name in kept_files(d)]
+    return _keep_into(dest, pairs, sweep)
 
 
 def keep(sweep_dir: Path, dest: Path) -> Path:
@@ -170,11 +188,10 @@ def keep(sweep_dir: Path, dest: Path) -> Path:
     same numbers. Returns ``dest``."""
     sweep_dir, dest = Path(sweep_dir), Path(dest)
     runs = load_runs(sweep_dir)  # refuses a folder with no finished run before anything is copied
-    copies = [(sweep_dir / "sweep.json", dest / "sweep.json")] if (sweep_dir / "sweep.json").is_file() else []
+    copies = [(sweep_dir / "sweep.json", "sweep.json")] if (sweep_dir / "sweep.json").is_file() else []
     for run in runs:
-        copies += [(run["run_dir"] / name, dest / run["trial"] / name) for name in kept_files(run["run_dir"])]
-    _copy(copies)
-    return dest
+        copies += [(run["run_dir"] / name, f"{run['trial']}/{name}") for name in kept_files(run["run_dir"])]
+    return _keep_into(dest, copies)
 
 
 # --------------------------------------------------------------------------------------- report

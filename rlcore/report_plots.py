@@ -31,7 +31,6 @@ def learning_curve(run_dirs: list[Path], points: int = 40) -> tuple[np.ndarray, 
     return grid, np.stack([np.interp(grid, s, v) for s, v in curves])
 
 
-
 def _iqm_band(curves: np.ndarray, reps: int) -> tuple[list, list, list]:
     """IQM over runs at each column of a [runs, points] matrix, with its 95 % bootstrap interval."""
     metrics = require("rliable.metrics", "A sweep report")  # the sweep extra
@@ -100,6 +99,8 @@ def plot_evals(result: dict, out: Path, reps: int = 1000) -> Path | None:
     for s in sweeps:
         runs = [read_evals(r["run_dir"]) for r in s["runs"]]
         steps = sorted(set.intersection(*({e.env_steps for e in evals} for evals in runs)))
+        if len(steps) > 40:  # a band of at most 40 points, as the learning curve's (600 evaluations: CartPole A2C)
+            steps = [steps[i] for i in np.linspace(0, len(steps) - 1, 40).round().astype(int)]
         line = None
         if steps:
             curves = np.array([[next(e.mean for e in evals if e.env_steps == x) for x in steps] for evals in runs])

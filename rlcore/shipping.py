@@ -123,13 +123,20 @@ def run_evaluation(exp, policy, episodes: int, seed_base: int | None) -> tuple[d
     return summary, line
 
 
-def evaluate_into_meta(model_dir: Path, episodes: int, seed_base: int | None = None) -> dict:
+def evaluate_into_meta(model_dir: Path, episodes: int, seed_base: int | None = None,
+                       experiment: str | None = None, algo: str | None = None) -> dict:
+    """Evaluate a model on unseen seeds and write the result into its meta.json as its ``evaluation``.
+    Refused when those seeds overlap a further evaluation already recorded (it would no longer be held
+    out)."""
     from rlcore.atomic import write_json
-    from rlcore.policies import load_policy
-
     from rlcore.machine import this_machine
+    from rlcore.policies import load_policy, read_meta
 
-    exp, meta, policy = load_policy(model_dir)
+    exp = experiment_of(model_dir)
+    seed_base = exp.eval_seed_base if seed_base is None else seed_base
+    _check_seeds_free(range(seed_base, seed_base + episodes), read_meta(model_dir).get("further_evaluations", []),
+                      "a further evaluation")
+    exp, meta, policy = load_policy(model_dir, experiment, algo)
     meta["evaluation"], line = run_evaluation(exp, policy, episodes, seed_base)
     meta["evaluation"]["machine"] = this_machine()  # where these episodes replay exactly (rlcore.machine)
     write_json(model_dir / "meta.json", meta)
@@ -139,34 +146,61 @@ def evaluate_into_meta(model_dir: Path, episodes: int, seed_base: int | None = N
 
 def seed_range(evaluation: dict) -> range:
     """The seeds a recorded evaluation played (its ``seeds``, ``"1000000..1000009"``)."""
-    first, last = (int(x) for x in evaluation["seeds"].split(".."))
+    try:
+        first, last = (int(x) for x in evaluation["seeds"].split(".."))
+    except (KeyError, ValueError, AttributeError):
+        raise UserError(f"a recorded evaluation does not say which seeds it played (seeds: "
+                        f"{evaluation.get('seeds')!r}); evaluate the model again with --record") from None
     return range(first, last + 1)
 
 
-def evaluate_further_into_meta(model_dir: Path, episodes: int, seed_base: int | None = None) -> dict:
+def _check_seeds_free(wanted: range, recorded: list[dict], what: str) -> None:
+    for ev in recorded:
+        played = seed_range(ev)
+        if wanted.start < played.stop and played.start < wanted.stop:
+            raise UserError(f"seeds {wanted.start}..{wanted.stop - 1} overlap those of {what} already recorded "
+                            f"({ev['seeds']}), which would no longer be held out: choose other seeds with "
+                            f"--seed-base (from {max(seed_range(r).stop for r in recorded)})")
+
+
+def experiment_of(model_dir: Path):
+    """The experiment a model folder's meta.json names, without loading the model."""
+    from rlcore.experiment import get_experiment
+    from rlcore.policies import read_meta
+
+    meta = read_meta(model_dir)
+    if not meta.get("experiment"):
+        raise UserError(f"{model_dir / 'meta.json'} names no experiment: not a model folder of this package")
+    return get_experiment(meta["experiment"], meta.get("env"))
+
+
+def evaluate_further_into_meta(model_dir: Path, episodes: int, seed_base: int | None = None,
+                               experiment: str | None = None, algo: str | None = None) -> dict:
     """Evaluate a model again on unseen seeds that no recorded evaluation of it played, and add the
     result to its meta.json's ``further_evaluations`` (its ``evaluation`` kept). By default the seeds
-    follow the last ones recorded. A held-out check: the model was chosen by its ``evaluation``."""
+    follow the last ones recorded. A held-out check: more episodes on seeds nothing chose the model by."""
     from rlcore.atomic import write_json
     from rlcore.machine import this_machine
-    from rlcore.policies import load_policy
+    from rlcore.policies import load_policy, read_meta
 
-    exp, meta, policy = load_policy(model_dir)
-    recorded = [ev for ev in [meta.get("evaluation"), *meta.get("further_evaluations", [])] if ev and ev.get("seeds")]
+    def recorded_evaluations() -> list[dict]:
+        meta = read_meta(model_dir)
+        return [ev for ev in [meta.get("evaluation"), *meta.get("further_evaluations", [])] if ev]
+
+    exp = experiment_of(model_dir)
+    recorded = recorded_evaluations()
     if seed_base is None:
         seed_base = max((seed_range(ev).stop for ev in recorded), default=exp.eval_seed_base)
     wanted = range(seed_base, seed_base + episodes)
     if wanted.start < exp.eval_seed_base or wanted.stop > exp.selection_seed_base:
         raise UserError(f"--seed-base {seed_base} with {episodes} episodes plays seeds {wanted.start}..{wanted.stop - 1}, "
                         f"outside {exp.name}'s unseen range {exp.eval_seed_base}..{exp.selection_seed_base - 1}")
-    for ev in recorded:
-        played = seed_range(ev)
-        if wanted.start < played.stop and played.start < wanted.stop:
-            raise UserError(f"seeds {wanted.start}..{wanted.stop - 1} overlap those of an evaluation already recorded "
-                            f"({ev['seeds']}); a further evaluation plays other seeds: leave out --seed-base, or "
-                            f"give one from {max(r.stop for r in map(seed_range, recorded))}")
+    _check_seeds_free(wanted, recorded, "an evaluation")
+    exp, _, policy = load_policy(model_dir, experiment, algo)
     summary, line = run_evaluation(exp, policy, episodes, seed_base)
     summary["machine"] = this_machine()
+    _check_seeds_free(wanted, recorded_evaluations(), "an evaluation")  # another process may have recorded some
+    meta = read_meta(model_dir)
     meta["further_evaluations"] = [*meta.get("further_evaluations", []), summary]
     write_json(model_dir / "meta.json", meta)
     print(f"further evaluation (unseen seeds): {line}")
@@ -174,28 +208,13 @@ def evaluate_further_into_meta(model_dir: Path, episodes: int, seed_base: int | 
 
 
 def publish(model_dir: Path, target: Path) -> None:
-    """Make ``target`` (a saved_networks/ folder) an exact copy of ``model_dir``, replacing it whole.
+    """Make ``target`` (a saved_networks/ folder) an exact copy of ``model_dir``, replacing it whole
+    (:func:`rlcore.atomic.replace_folder`: files of an earlier model that the new one lacks do not
+    survive, and a crash leaves the old folder or the new one, never a mix)."""
+    from rlcore.atomic import replace_folder
 
-    The copy is built beside the target, then swapped in with two renames; files of an earlier
-    model that the new one lacks do not survive. A crash leaves either the old folder or the new
-    one in place, plus at most a hidden ``.NAME.old-*`` / ``.NAME.new-*`` folder to delete.
-    """
-    import os
-    import tempfile
-
-    target.parent.mkdir(parents=True, exist_ok=True)
-    fresh = Path(tempfile.mkdtemp(prefix=f".{target.name}.new-", dir=target.parent))
-    try:
+    def fill(fresh: Path) -> None:
         for src in sorted(p for p in model_dir.iterdir() if p.is_file()):
             shutil.copyfile(src, fresh / src.name)
-        os.chmod(fresh, 0o755)
-        if target.exists():
-            old = Path(tempfile.mkdtemp(prefix=f".{target.name}.old-", dir=target.parent))
-            os.replace(target, old / target.name)
-            os.replace(fresh, target)
-            shutil.rmtree(old)
-        else:
-            os.replace(fresh, target)
-    finally:
-        if fresh.exists():
-            shutil.rmtree(fresh)
+
+    replace_folder(target, fill)

@@ -1,6 +1,7 @@
 """main.py end to end: commands, and every bad input giving one clear line and a non-zero exit."""
 import json
 import os
+import shutil
 import subprocess
 import sys
 import time
@@ -295,13 +296,22 @@ def test_a_further_evaluation_plays_the_next_unseen_seeds_and_keeps_the_evaluati
     assert meta["evaluation"] == evaluation
     assert [ev["seeds"] for ev in meta["further_evaluations"]] == ["10005..10007", "10008..10010"]
     assert all(len(ev["per_episode"]) == 3 and "machine" in ev for ev in meta["further_evaluations"])
-    for extra, message in ((["--seed-base", "10002"], "seeds 10002..10004 overlap those of an evaluation already "
-                                                      "recorded (10000..10004)"),
-                           (["--seed-base", "5"], "plays seeds 5..7, outside toy's unseen range 10000..1999999"),
-                           (["--record"], "give --record (the model's evaluation) or --record-further")):
-        code, _, err = run(capsys, *model, "--episodes", "3", "--record-further", *extra)
+    for argv, message in (
+            (["--record-further", "--seed-base", "10002"], "seeds 10002..10004 overlap those of an evaluation "
+                                                           "already recorded (10000..10004)"),
+            (["--record-further", "--seed-base", "10006"], "seeds 10006..10008 overlap those of an evaluation "
+                                                           "already recorded (10005..10007)"),
+            (["--record-further", "--seed-base", "5"], "plays seeds 5..7, outside toy's unseen range 10000..1999999"),
+            (["--record-further", "--record"], "give --record (the model's evaluation) or --record-further"),
+            # a new evaluation over the further ones' seeds would leave them no longer held out
+            (["--record", "--episodes", "20"], "seeds 10000..10019 overlap those of a further evaluation already "
+                                               "recorded (10005..10007)")):
+        code, _, err = run(capsys, *model, "--episodes", "3", *argv)
         assert code == 2 and message in err and len(err.strip().splitlines()) == 1, err
     assert json.loads(meta_path.read_text()) == meta  # nothing written by a refused command
+    shutil.rmtree(spec.run_dir / "model")  # a run in progress (a checkpoint, no model): nothing to record into
+    code, _, err = run(capsys, *model, "--record-further")
+    assert code == 2 and "--record-further writes into a model folder" in err and "is a run in progress" in err
 
 
 def test_the_flags_that_choose_a_shipped_model_come_from_the_registry(capsys, monkeypatch, tmp_path):

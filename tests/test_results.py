@@ -41,12 +41,15 @@ def test_the_experiment_page_tells_each_kept_sweeps_collapses_as_its_evaluations
     from rlcore.docgen_sweeps import collapses_cell
     from rlcore.eval_history import stability_summary
 
-    experiment = name.split("__")[0]
+    experiment, model = name.split("__")
     page = (ROOT / "docs" / "experiments" / f"{experiment}.md").read_text()
-    stories = [r["story"] for r in load_runs(KEPT / name)]
-    assert stability_summary(stories) in page
-    for st in stories:
-        assert f"| {collapses_cell(st.collapses)} |" in page
+    region = page.partition("<!-- generated:sweep-stability")[2].partition("<!-- /generated -->")[0]
+    section = region.partition(f"**[{model}](../results/sweeps/{name}/report.md)**: ")[2].partition("\n**[")[0]
+    runs = load_runs(KEPT / name)
+    assert section.startswith(stability_summary([r["story"] for r in runs]))
+    rows = {line.split("|")[1].strip(): line for line in section.splitlines() if line.startswith("| ")}
+    for r in runs:
+        assert f"| {collapses_cell(r['story'].collapses)} |" in rows[str(r["seed"])]
 
 
 def test_a_seed_summary_gives_the_iqm_each_seed_and_the_shipped_model_beside_them():

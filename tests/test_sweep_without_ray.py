@@ -190,6 +190,41 @@ def test_single_runs_over_seeds_are_kept_and_reported_as_a_sweep_of_their_level(
     monkeypatch.setattr(docgen_data, "REPO", tmp_path)
     found = docgen_data.kept_sweeps()
     assert list(found) == [("mario_ppo", "1-1")] and found[("mario_ppo", "1-1")].seeds == [(0, 0.9), (1, 1.0), (2, 0.6)]
+    # the docs' regions for it, beside a shipped 1-1 (flag in 8 of 10); PPO has no periodic evaluations
+    from rlcore import docgen_sweeps
+    from rlcore.experiment import get_experiment
+
+    shipped = docgen_data.Model("mario_ppo", "1-1", "saved_networks/mario_ppo/1-1",
+                                {"algo": "ppo", "seed": 0, "evaluation": {"episodes": 10, "success_share": 0.8}},
+                                get_experiment("mario_ppo").bar("1-1"), found[("mario_ppo", "1-1")])
+    monkeypatch.setattr(docgen_sweeps, "REPO", tmp_path)
+    monkeypatch.setattr(docgen_sweeps, "shipped_models", lambda: [shipped])
+    summary = docgen_sweeps.seed_summary("README.md", "mario_ppo")
+    assert ("per seed 0: flag in 9 of 10 after 1,000 env steps, 10 s; 1: flag in 10 of 10 after 2,000 env steps, 10 s; "
+            "2: flag in 6 of 10 after 3,000 env steps, 10 s; the shipped model (seed 0, a run of its own) flag in 8 of "
+            "10.") in summary and "During training" not in summary
+    assert "its runs made no periodic evaluations" in docgen_sweeps.sweep_stability("docs/x.md", "mario_ppo")
+    rows = docgen_sweeps.seed_runs("docs/x.md", "mario_ppo")
+    assert "| 0 | flag in 9 of 10 | flag in 27 of 30 (1000010..1000039) | 1,000 | 10 s | 100 | – |" in rows
+    assert "| 1 | flag in 10 of 10 | – |" in rows
+
+
+def test_keeping_again_replaces_the_kept_folder_whole_and_never_another_folder(tmp_path, capsys):
+    runs = [str(_mario_run(tmp_path / f"run{s}", s, 8)) for s in range(3)]
+    kept = tmp_path / "kept"
+    assert run(capsys, "report", *runs, "--keep", str(kept), "--reps", "100")[0] == 0
+    assert run(capsys, "report", *runs[:2], "--keep", str(kept), "--reps", "100")[0] == 0
+    assert sorted(p.name for p in kept.glob("seed=*")) == ["seed=0", "seed=1"]  # seed 2's files went
+    assert json.loads((kept / "sweep.json").read_text())["seeds"] == [0, 1]
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".kept.")]  # no build folder left
+    (tmp_path / "notes").mkdir()
+    (tmp_path / "notes" / "mine.txt").write_text("a user's file")
+    (tmp_path / "afile").write_text("x")
+    for dest, message in ((tmp_path / "notes", "that folder holds other files and no kept sweep"),
+                          (tmp_path / "afile", "a file is there; give a folder")):
+        code, _, err = run(capsys, "report", *runs, "--keep", str(dest))
+        assert code == 2 and message in err and len(err.strip().splitlines()) == 1, err
+    assert (tmp_path / "notes" / "mine.txt").read_text() == "a user's file"
 
 
 @pytest.mark.parametrize("case, message", [

@@ -53,19 +53,19 @@ def test_story_reads_the_run_folder_and_says_which_weights_the_model_holds(tmp_p
     (tmp_path / "evals.csv").write_text("\n".join(lines) + "\n")
     s = story(tmp_path, {"weights": "best periodic evaluation"})
     assert (s.evaluations, s.best.env_steps, s.last.mean, len(s.collapses)) == (20, 700_000, 14.05, 3)
-    assert s.shielded and s.best.time_limit_share == 1.0
+    assert s.keep_best_mattered and s.best.time_limit_share == 1.0
     assert story_text(s) == ("3 collapses (400k: 0.19 after 14.76, back by 500k; 650k: 0.14 after 16.76, back by "
                              "700k; 850k: 0.67 after 18.35, back by 900k); model: weights of the best evaluation "
                              "(18.35 at 700k), the last scored 14.05")
     last = story(tmp_path, {"weights": "last"})
-    assert not last.shielded and story_text(last).endswith("model: the last weights")
+    assert not last.keep_best_mattered and story_text(last).endswith("model: the last weights")
 
 
 def test_a_tie_goes_to_the_later_evaluation_as_in_training(tmp_path):
     (tmp_path / "evals.csv").write_text("env_steps,episode,eval_mean,eval_std,eval_time_limit_share\n"
                                         "1000,1,500.0,0,1\n2000,2,300.0,0,0\n3000,3,500.0,0,1\n")
     s = story(tmp_path, {"weights": "best periodic evaluation"})
-    assert s.best.env_steps == 3000 and not s.shielded and story_text(s).endswith("also the last")
+    assert s.best.env_steps == 3000 and not s.keep_best_mattered and story_text(s).endswith("also the last")
 
 
 def test_no_evals_csv_is_no_story_and_a_damaged_one_is_one_line(tmp_path):
