@@ -9,6 +9,15 @@ from __future__ import annotations
 from rlcore.docgen_data import REPO, read_json, shipped_models
 from rlcore.eval_history import stability_summary, steps_text, story
 
+#: what the sweep-stability region says before its tables (the rule is rlcore.eval_history's)
+STABILITY_INTRO = ("What the periodic evaluations (on selection seeds) saw through training: a *collapse* is an "
+                   "evaluation that falls below a quarter of the way up from the run's first evaluation to its best "
+                   "before it, once the run has made half of its best gain; it is *back* at the first evaluation three "
+                   "quarters of the way up again (`rlcore/eval_history.py`).")
+SEED_RUNS_INTRO = ("Each seed's run: its score on unseen seeds (and further evaluations on other unseen seeds), env "
+                   "steps, wall time and speed on the machine that trained it (its CPU in the report), and what "
+                   "ended it.")
+
 
 def _runs(folder: str) -> list[tuple[dict, object]]:
     """(meta, story) of each finished run of a kept sweep, by seed."""
@@ -60,9 +69,7 @@ def sweep_stability(page: str, experiment: str) -> str:
                      f"of its episodes that lasted to the time limit.\n\n"
                      + table(["seed", "unseen seeds", "best evaluation (at)", "last", "collapses: at → back by",
                               "deepest"], rows, "rrrrll"))
-    if not parts:
-        return "*No sweep over seeds is kept in `results/sweeps/` for this experiment yet.*"
-    return "\n\n".join(parts)
+    return "\n\n".join([STABILITY_INTRO, *parts]) if parts else ""  # nothing until a sweep is kept
 
 
 def seed_summary(page: str, experiment: str) -> str:
@@ -119,6 +126,4 @@ def seed_runs(page: str, experiment: str) -> str:
                      f"{score_text(m)}:\n\n"
                      + table(["seed", "unseen seeds", "further unseen seeds", "env steps", "wall", "env steps/s",
                               "stopped by"], rows, "rrrrrrl"))
-    if not parts:
-        return "*No sweep over seeds is kept in `results/sweeps/` for this experiment yet.*"
-    return "\n\n".join(parts)
+    return "\n\n".join([SEED_RUNS_INTRO, *parts]) if parts else ""  # nothing until a sweep is kept
