@@ -6,7 +6,7 @@ each seed's score and the shipped model's beside them). Part of :mod:`rlcore.doc
 TensorFlow-free."""
 from __future__ import annotations
 
-from rlcore.docgen_data import REPO, read_json, shipped_models
+from rlcore import docgen_data  # its REPO and shipped_models read at each call (tests point them elsewhere)
 from rlcore.eval_history import stability_summary, steps_text, story
 
 #: what the sweep-stability region says before its tables (the rule is rlcore.eval_history's)
@@ -22,8 +22,8 @@ SEED_RUNS_INTRO = ("Each seed's run: its score on unseen seeds (and further eval
 def _runs(folder: str) -> list[tuple[dict, object]]:
     """(meta, story) of each finished run of a kept sweep, by seed."""
     runs = []
-    for meta_path in (REPO / folder).glob("*/model/meta.json"):
-        meta = read_json(meta_path)
+    for meta_path in (docgen_data.REPO / folder).glob("*/model/meta.json"):
+        meta = docgen_data.read_json(meta_path)
         runs.append((meta, story(meta_path.parent.parent, meta)))
     return sorted(runs, key=lambda run: run[0]["seed"])
 
@@ -41,7 +41,7 @@ def sweep_stability(page: str, experiment: str) -> str:
     from rlcore.docgen import link, sweep_score, table
 
     parts = []
-    for m in shipped_models():
+    for m in docgen_data.shipped_models():
         if m.experiment != experiment or m.sweep is None:
             continue
         runs = _runs(m.sweep.folder)
@@ -76,7 +76,7 @@ def seed_summary(page: str, experiment: str) -> str:
     from rlcore.docgen import iqm_text, link, score_text
 
     parts = []
-    for m in shipped_models():
+    for m in docgen_data.shipped_models():
         if m.experiment != experiment or m.sweep is None:
             continue
         runs = _runs(m.sweep.folder)
@@ -111,7 +111,7 @@ def seed_runs(page: str, experiment: str) -> str:
     from rlcore.docgen import link, score_text, table
 
     parts = []
-    for m in shipped_models():
+    for m in docgen_data.shipped_models():
         if m.experiment != experiment or m.sweep is None:
             continue
         rows = []

@@ -171,7 +171,8 @@ def _mario_run(folder: Path, seed: int, flags: int, further: int | None = None, 
 def test_single_runs_over_seeds_are_kept_and_reported_as_a_sweep_of_their_level(tmp_path, capsys, monkeypatch):
     """Mario 1-1's seeds are three `train` runs: `report RUN... --keep DIR` keeps them like a sweep (a budget
     given again on a resume may differ), and the docs generator finds them as the sweep of level 1-1."""
-    from rlcore import docgen_data
+    # imported before docgen_data.REPO points at tmp_path below: a module imported while it does would keep it
+    from rlcore import docgen, docgen_cards, docgen_data, docgen_sweeps  # noqa: F401
 
     runs = [str(_mario_run(tmp_path / "long_runs" / f"1-1-seed-{s}", s, flags, further, max_env_steps=budget))
             for s, flags, further, budget in ((0, 9, 27, 10**7), (1, 10, None, 2 * 10**7), (2, 6, 20, 10**7))]
@@ -191,14 +192,12 @@ def test_single_runs_over_seeds_are_kept_and_reported_as_a_sweep_of_their_level(
     found = docgen_data.kept_sweeps()
     assert list(found) == [("mario_ppo", "1-1")] and found[("mario_ppo", "1-1")].seeds == [(0, 0.9), (1, 1.0), (2, 0.6)]
     # the docs' regions for it, beside a shipped 1-1 (flag in 8 of 10); PPO has no periodic evaluations
-    from rlcore import docgen_sweeps
     from rlcore.experiment import get_experiment
 
     shipped = docgen_data.Model("mario_ppo", "1-1", "saved_networks/mario_ppo/1-1",
                                 {"algo": "ppo", "seed": 0, "evaluation": {"episodes": 10, "success_share": 0.8}},
                                 get_experiment("mario_ppo").bar("1-1"), found[("mario_ppo", "1-1")])
-    monkeypatch.setattr(docgen_sweeps, "REPO", tmp_path)
-    monkeypatch.setattr(docgen_sweeps, "shipped_models", lambda: [shipped])
+    monkeypatch.setattr(docgen_data, "shipped_models", lambda: [shipped])
     summary = docgen_sweeps.seed_summary("README.md", "mario_ppo")
     assert ("per seed 0: flag in 9 of 10 after 1,000 env steps, 10 s; 1: flag in 10 of 10 after 2,000 env steps, 10 s; "
             "2: flag in 6 of 10 after 3,000 env steps, 10 s; the shipped model (seed 0, a run of its own) flag in 8 of "
