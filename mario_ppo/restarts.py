@@ -39,21 +39,8 @@ every evaluation and video starts at the level's start. Restarted episodes are m
 (``info["restarted"]``) and left out of the flag share that the stop rule reads; ``info["start_x"]``
 says where each episode started (metrics.csv: which points are hard).
 
-A kept point is an emulator state and its route: the buttons, one per NES frame, that lead to it
-from the level's start (through the routes of the restarts it came from). The emulator is
-deterministic, so a checkpoint keeps the routes (``restart_routes``, a few KB each) and a resumed run
-replays them to get its points back; the emulator's own state cannot be written to a file. With
-"furthest", the route a checkpoint keeps for a point is that of its episode up to the episode's reach,
-and a replayed route offers every point it passes with the reach of where it ends: the points and
-reaches come back, even when the spacing or the restart x has changed.
-
-A restart does not load the point's own state but one 16-19 frames before it (a state is kept every
-:data:`DUMP_EVERY` frames, not every frame: a dump costs ~2 % of a frame), and replays the route from
-there: the last :data:`WARMUP` frames it shows (``info["warmup_frames"]``) let the frame stack above
-start as it was in the episode that passed the point, not as one frame four times.
-Mid-jump, that is the difference between a Mario seen rising and one hanging still (from the states
-of 1-3's old crossings, before the warm-up, the policy crossed in up to 8 of 8 tries from x 630 and in
-0-1 of 8 from x 620, a few frames earlier in the same jumps).
+How a point's state is kept, loaded and got back from its route (the emulator's side, nes-py's private
+calls included): :mod:`mario_ppo.emulator_states`.
 
 TensorFlow-free: env-pool worker processes import this module.
 """
@@ -61,32 +48,17 @@ from __future__ import annotations
 
 from collections import Counter, deque
 from collections.abc import Iterable
-from typing import NamedTuple
 
 import gymnasium as gym
 import numpy as np
 
 from mario_ppo.curriculum import X_KEY, StepBack, stepped_x
+from mario_ppo.emulator_states import DUMP_EVERY, Kept, dump, kept_at, load, recent_states, replay
 
 WEIGHTS = ("uniform", "deaths")
 KEEPS = ("latest", "furthest")
 FLAG = 10**9  # the reach of an episode that got the flag: past every x
-WARMUP = 16  # frames shown from a restart's replay: 4 agent steps of 4 frames, what the frame stacks show
-DUMP_EVERY = 4  # frames between the states kept for a warm-up (a dump costs ~2 % of a frame)
 DEATHS_KEPT = 100  # failed episodes per env that weigh the points: ~30 rollouts of 8 envs on 2-2
-
-
-class Kept(NamedTuple):
-    """How a restart starts at a point: load ``earlier``, then play the last ``warmup`` frames of
-    ``route`` (the buttons from the level's start to the point)."""
-    earlier: object
-    route: bytes
-    warmup: int
-
-
-def _recent_states(*first: tuple[object, int]) -> deque:
-    """Room for the (state, route length) pairs of the last WARMUP + DUMP_EVERY frames."""
-    return deque(first, maxlen=WARMUP // DUMP_EVERY + 2)
 
 
 def death_weights(points: list[int], failures: Iterable[int]) -> np.ndarray:
@@ -127,7 +99,7 @@ class Restarts(gym.Wrapper):
         self.failures: deque[int] = deque(maxlen=DEATHS_KEPT)  # the point each failed episode ended at
         self._last: dict | None = None  # the info of this episode's last step (None: no step yet)
         self._snapshots: dict[int, Kept] = {}  # point number -> how to start there
-        self._recent = _recent_states()  # (state, route length) every DUMP_EVERY frames
+        self._recent = recent_states()  # (state, route length) every DUMP_EVERY frames
         self._reach: dict[int, int] = {}  # point number -> the reach of the episode its state came from
         self._passed_states: dict[int, Kept] = {}  # this episode's, for keep="furthest"
         self._furthest_x = 0  # this episode's reach so far
@@ -161,25 +133,13 @@ class Restarts(gym.Wrapper):
                 pick = self.np_random.choice(len(points), p=death_weights(points, self.failures))
             else:
                 pick = self.np_random.integers(len(points))
-            obs, info = self._load(self._snapshots[points[pick]])
+            kept = self._snapshots[points[pick]]
+            obs, info = load(self.env, kept)
+            self._route = bytearray(kept.route)
         self._passed = self.point(info["x_pos"])
         self._start_x = int(info["x_pos"])
-        self._recent = _recent_states((self.env.unwrapped.dump_state(), len(self._route)))
+        self._recent = recent_states((dump(self.env), len(self._route)))
         info["restarted"], info["start_x"] = self._restarted, self._start_x
-        return obs, info
-
-    def _load(self, kept: Kept):
-        """Start at ``kept``'s point: load its earlier state and play the route's last frames; the
-        last screen and info, with the last WARMUP screens played in ``info["warmup_frames"]``."""
-        base = self.env.unwrapped
-        base.load_state(kept.earlier)
-        base._did_reset()  # the env's own "last" counters (time, x, score) from the loaded state
-        obs, info, frames = base.screen, base._get_info(), []
-        for action in kept.route[len(kept.route) - kept.warmup:]:
-            obs, _, _, _, info = self.env.step(action)
-            frames.append(np.array(obs))
-        self._route = bytearray(kept.route)
-        info["warmup_frames"] = frames[-WARMUP:]
         return obs, info
 
     def _move_to(self, x: int) -> None:
@@ -191,24 +151,17 @@ class Restarts(gym.Wrapper):
         self._snapshots, self._reach, self._full_routes = {}, {}, {}  # a flag's reach would outrank its replay's
         self.restart_routes = routes
 
-    @staticmethod
-    def _kept(recent: deque, route: bytes) -> Kept:
-        """The point just passed at the end of ``route``, from the newest of the ``recent`` states at
-        least WARMUP frames before it (else the oldest)."""
-        earlier, length = next((s for s in reversed(recent) if len(route) - s[1] >= WARMUP), recent[0])
-        return Kept(earlier, route, len(route) - length)
-
     def step(self, action):
         obs, reward, terminated, truncated, info = self.env.step(action)
         self._route.append(int(action))
         if len(self._route) - self._recent[-1][1] >= DUMP_EVERY:
-            self._recent.append((self.env.unwrapped.dump_state(), len(self._route)))
+            self._recent.append((dump(self.env), len(self._route)))
         self._last = info
         alive = not (terminated or truncated or info.get("is_dying"))
         reached = self.point(info["x_pos"])
         if reached > self._passed:
             if alive:
-                state = self._kept(self._recent, bytes(self._route))
+                state = kept_at(self._recent, bytes(self._route))
                 kept = self._snapshots if self.keep == "latest" else self._passed_states  # see reset
                 kept[reached] = state
             self._passed = reached
@@ -253,27 +206,8 @@ class Restarts(gym.Wrapper):
             self.x = self.stepper.restore(stepped)
         for key, route in sorted(routes.items(), key=lambda item: int(item[0])):
             route = np.asarray(route, np.uint8)
-            passed, end_x = self._replay(route)
+            passed, end_x = replay(self.env, route, self.point)
             if self.keep == "furthest":
                 self._keep_furthest(passed, end_x, route.tobytes())
             elif int(key) in passed and int(key) == max(passed):
                 self._snapshots[int(key)] = passed[int(key)]
-
-    def _replay(self, route: np.ndarray) -> tuple[dict[int, Kept], int]:
-        """How to start at each point that ``route``, played from the level's start, passes alive,
-        and the x where it ends (nothing if it dies or ends before its last frame)."""
-        self.env.reset()
-        recent = _recent_states((self.env.unwrapped.dump_state(), 0))
-        info = {"x_pos": -1}
-        passed, furthest = {}, 0
-        for frame, action in enumerate(route):
-            _, _, terminated, truncated, info = self.env.step(int(action))
-            if (frame + 1) % DUMP_EVERY == 0:
-                recent.append((self.env.unwrapped.dump_state(), frame + 1))
-            if terminated or truncated:
-                return {}, 0
-            point = self.point(info["x_pos"])
-            if point > furthest and not info.get("is_dying"):
-                passed[point] = self._kept(recent, route[: frame + 1].tobytes())
-                furthest = point
-        return ({}, 0) if info.get("is_dying") else (passed, int(info["x_pos"]))
