@@ -48,6 +48,7 @@ from __future__ import annotations
 
 from collections import Counter, deque
 from collections.abc import Iterable
+from typing import NamedTuple
 
 import gymnasium as gym
 import numpy as np
@@ -59,6 +60,14 @@ WEIGHTS = ("uniform", "deaths")
 KEEPS = ("latest", "furthest")
 FLAG = 10**9  # the reach of an episode that got the flag: past every x
 DEATHS_KEPT = 100  # failed episodes per env that weigh the points: ~30 rollouts of 8 envs on 2-2
+
+
+class Point(NamedTuple):
+    """A kept restart point: how to start there; with keep="furthest" also the reach of the episode its
+    state came from and that episode's route to its reach (what a checkpoint keeps of the point)."""
+    kept: Kept
+    reach: int = -1
+    full_route: bytes | None = None
 
 
 def death_weights(points: list[int], failures: Iterable[int]) -> np.ndarray:
@@ -98,13 +107,11 @@ class Restarts(gym.Wrapper):
         self.stepper = StepBack(x, back_step, goal_x, back_share) if back_step else None
         self.failures: deque[int] = deque(maxlen=DEATHS_KEPT)  # the point each failed episode ended at
         self._last: dict | None = None  # the info of this episode's last step (None: no step yet)
-        self._snapshots: dict[int, Kept] = {}  # point number -> how to start there
+        self._points: dict[int, Point] = {}  # point number -> how to start there (and, "furthest", its reach)
         self._recent = recent_states()  # (state, route length) every DUMP_EVERY frames
-        self._reach: dict[int, int] = {}  # point number -> the reach of the episode its state came from
         self._passed_states: dict[int, Kept] = {}  # this episode's, for keep="furthest"
         self._furthest_x = 0  # this episode's reach so far
         self._furthest_frame = 0  # the length of its route when it got there
-        self._full_routes: dict[int, bytes] = {}  # keep="furthest": point -> its episode's route to its reach
         self._restarted = False
         self._passed = 0
         self._start_x = 0
@@ -125,15 +132,15 @@ class Restarts(gym.Wrapper):
         self._last = None
         self._passed_states, self._furthest_x, self._furthest_frame = {}, 0, 0
         obs, info = self.env.reset(seed=seed, options=options)
-        self._restarted = bool(self._snapshots) and self.np_random.random() < self.share
+        self._restarted = bool(self._points) and self.np_random.random() < self.share
         self._route = bytearray()
         if self._restarted:
-            points = sorted(self._snapshots)
+            points = sorted(self._points)
             if self.weights == "deaths":
                 pick = self.np_random.choice(len(points), p=death_weights(points, self.failures))
             else:
                 pick = self.np_random.integers(len(points))
-            kept = self._snapshots[points[pick]]
+            kept = self._points[points[pick]].kept
             obs, info = load(self.env, kept)
             self._route = bytearray(kept.route)
         self._passed = self.point(info["x_pos"])
@@ -148,7 +155,7 @@ class Restarts(gym.Wrapper):
         routes = self.restart_routes
         routes.pop(X_KEY, None)
         self.x = x
-        self._snapshots, self._reach, self._full_routes = {}, {}, {}  # a flag's reach would outrank its replay's
+        self._points = {}  # a flag's reach would outrank its replay's
         self.restart_routes = routes
 
     def step(self, action):
@@ -162,8 +169,10 @@ class Restarts(gym.Wrapper):
         if reached > self._passed:
             if alive:
                 state = kept_at(self._recent, bytes(self._route))
-                kept = self._snapshots if self.keep == "latest" else self._passed_states  # see reset
-                kept[reached] = state
+                if self.keep == "latest":
+                    self._points[reached] = Point(state)
+                else:
+                    self._passed_states[reached] = state  # kept at the episode's end, by its reach (see reset)
             self._passed = reached
         if alive and info["x_pos"] > self._furthest_x:
             self._furthest_x, self._furthest_frame = int(info["x_pos"]), len(self._route)
@@ -176,16 +185,15 @@ class Restarts(gym.Wrapper):
         """keep="furthest": keep each state of ``passed`` (point -> state, from an episode that
         reached x ``reach`` alive along ``full_route``) where ``reach`` is at least the kept state's."""
         for point, state in passed.items():
-            if reach >= self._reach.get(point, -1):
-                self._snapshots[point], self._reach[point] = state, reach
-                self._full_routes[point] = full_route
+            if point not in self._points or reach >= self._points[point].reach:
+                self._points[point] = Point(state, reach, full_route)
 
     @property
     def restart_routes(self) -> dict[str, np.ndarray]:
         """The route (uint8 buttons, one per frame) of each kept point, keyed by its number: to the
         point, or with keep="furthest" to the reach of the episode the point's state came from."""
-        routes = (self._full_routes if self.keep == "furthest"
-                  else {point: kept.route for point, kept in self._snapshots.items()})
+        routes = {point: kept.full_route if self.keep == "furthest" else kept.kept.route
+                  for point, kept in self._points.items()}
         kept = {str(point): np.frombuffer(route, np.uint8) for point, route in routes.items()}
         if self.stepper:
             kept[X_KEY] = np.array([self.x], np.int64)
@@ -210,4 +218,4 @@ class Restarts(gym.Wrapper):
             if self.keep == "furthest":
                 self._keep_furthest(passed, end_x, route.tobytes())
             elif int(key) in passed and int(key) == max(passed):
-                self._snapshots[int(key)] = passed[int(key)]
+                self._points[int(key)] = Point(passed[int(key)])
