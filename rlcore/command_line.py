@@ -126,7 +126,7 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
             p.add_argument("--record-further", action="store_true",
                            help="add the result to the model folder's meta.json as a further evaluation on other "
                                 "unseen seeds, its evaluation kept; by default on the seeds right after the last "
-                                "ones recorded (a held-out check of a model chosen by its evaluation)")
+                                "ones recorded (more episodes, on seeds nothing chose the model by)")
         else:
             p.add_argument("--out", default=None,
                            help="an .mp4 or a .gif path (a GIF: ~320 px wide, every few frames, looping), "
