@@ -259,18 +259,26 @@ def load(model: ModelRef | Policy) -> Policy:
 
 # ---------------------------------------------------------------------- evaluate, render
 def evaluate(model: ModelRef | Policy, episodes: int | None = None, seed_base: int | None = None,
-             record: bool = False) -> dict[str, Any]:
+             record: bool = False, record_further: bool = False) -> dict[str, Any]:
     """Evaluate on unseen seeds as ``main.py evaluate`` does (episode i seeded ``seed_base + i``,
     default the experiment's evaluation range; ``episodes`` default 100, Mario 10): greedy
     mean/std/min of the return and per-episode records, or for Mario the share of episodes that
     reached the flag. ``line`` holds the one-line report. ``record``: also write it into the model
-    folder's meta.json as its evaluation."""
+    folder's meta.json as its evaluation. ``record_further``: add it to meta.json's
+    ``further_evaluations`` instead, on unseen seeds no recorded evaluation played (by default those
+    right after the last ones recorded), the evaluation kept."""
     from rlcore import shipping
 
+    if record and record_further:
+        raise UserError("give record (the model's evaluation) or record_further (one more), not both")
     policy = load(model)
     count = shipping.eval_episodes(policy.experiment, episodes)
     if count < 1:
         raise UserError(f"episodes must be at least 1, not {count}")
+    if record_further:
+        meta = shipping.evaluate_further_into_meta(policy.model_dir, count, seed_base)
+        policy.meta = meta
+        return dict(meta["further_evaluations"][-1])
     if record:
         meta = shipping.evaluate_into_meta(policy.model_dir, count, seed_base)
         policy.meta = meta

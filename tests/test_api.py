@@ -60,6 +60,10 @@ def test_train_records_the_call_evaluates_and_renders(tmp_path):
     # the same final evaluation as main.py train: unseen seeds, written into meta.json
     assert meta["evaluation"]["episodes"] == 3 and meta["evaluation"]["seeds"] == "1000000..1000002"
     assert run.evaluation == meta["evaluation"]
+    further = api.evaluate(run, episodes=2, record_further=True)  # the next unseen seeds, the evaluation kept
+    meta = json.loads((run.model_dir / "meta.json").read_text())
+    assert further["seeds"] == "1000003..1000004" and meta["further_evaluations"] == [further]
+    assert meta["evaluation"] == run.evaluation
     assert [table for table, _ in rows] == ["metrics"] * 4 and rows[-1][1]["episode"] == 4
     video = api.render(run, tmp_path / "clip.mp4", episodes=1)
     import imageio.v2 as imageio
