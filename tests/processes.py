@@ -18,6 +18,25 @@ def ray_pids() -> set[int]:
     return found
 
 
+def own_ray_processes() -> list[psutil.Process]:
+    """The Ray processes this process started (its descendants): not those of a Ray that another
+    process runs meanwhile (a sweep of another test worker, a user's own)."""
+    ray = ray_pids()
+    return [child for child in psutil.Process().children(recursive=True) if child.pid in ray]
+
+
+def alive(processes: list[psutil.Process]) -> list[int]:
+    """The pids of ``processes`` still running (a zombie, dead but not yet reaped, is not)."""
+    running = []
+    for proc in processes:
+        try:
+            if proc.is_running() and proc.status() != psutil.STATUS_ZOMBIE:
+                running.append(proc.pid)
+        except psutil.NoSuchProcess:
+            pass
+    return running
+
+
 def group_pids(pgid: int) -> set[int]:
     """The processes of a process group (a command started with ``start_new_session``)."""
     found = set()

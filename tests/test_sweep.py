@@ -16,7 +16,7 @@ from rlcore import experiment as registry
 from rlcore.checkpoint import read_checkpoint_state
 from rlcore.report import load_runs, summarize
 from rlcore.sweep import STOP_FILE, Sweep, run_sweep, start_ray
-from tests.processes import listening, outside_loopback, ray_pids
+from tests.processes import alive, listening, outside_loopback, own_ray_processes
 
 ROOT = Path(__file__).resolve().parents[1]
 BUDGET = {"max_episodes": 40, "stop_score": 99.0, "checkpoint_every": 10}
@@ -24,7 +24,6 @@ BUDGET = {"max_episodes": 40, "stop_score": 99.0, "checkpoint_every": 10}
 
 # Ray processes that were running before these tests started theirs (a developer's own sweep, say):
 # the tests look at their own Ray only
-OTHERS_RAY: set[int] = set()
 
 
 @pytest.fixture(scope="module")
@@ -32,7 +31,6 @@ def local_ray():
     """A local Ray of this module's own, started while RAY_ADDRESS names a cluster (as on a machine where
     the user works with one): a sweep without --address still starts its own."""
     registry.EXPERIMENT_MODULES["toy"] = "tests.toy"  # trials get the registry from the driver
-    OTHERS_RAY.update(ray_pids())
     before = os.environ.get("RAY_ADDRESS")
     os.environ["RAY_ADDRESS"] = "127.0.0.1:1"  # nothing listens there
     try:
@@ -54,7 +52,8 @@ def _sweep(tmp_path, name, seeds=(0, 1), **budget):
 
 
 def _ray_sockets():
-    return listening(ray_pids() - OTHERS_RAY)
+    """The sockets this module's Ray listens on."""
+    return listening({p.pid for p in own_ray_processes()})
 
 
 def _wait_for(path, timeout=120):
@@ -170,11 +169,13 @@ def test_a_trial_that_fails_with_a_user_error_is_reported_once_not_retried(local
 
 
 def test_no_ray_process_is_left_behind(local_ray):
+    """Every Ray process this module's Ray started is gone after shutdown (followed by process, so a Ray
+    that another test worker's sweep starts meanwhile does not count)."""
     import ray
+    ours = own_ray_processes()
+    assert ours, "this module's Ray has no process to follow"
     ray.shutdown()
     deadline = time.monotonic() + 20
-    while _ray_sockets() and time.monotonic() < deadline:
+    while alive(ours) and time.monotonic() < deadline:
         time.sleep(0.2)
-    assert not _ray_sockets()
-    left = ray_pids() - OTHERS_RAY
-    assert not left, left
+    assert not alive(ours), alive(ours)

@@ -146,7 +146,7 @@ class PPOAgent:
         self._forward = tf.function(lambda obs: self.model(obs), input_signature=[frames])
         t, n = cfg.n_steps, cfg.num_envs
         vec = tf.TensorSpec([t, n], tf.float32)
-        self._update = tf.function(self._update_graph, input_signature=[
+        self._update = tf.function(self._update_graph, autograph=False, input_signature=[
             tf.TensorSpec([t, n, *self.obs_shape], tf.as_dtype(self.obs_dtype)), tf.TensorSpec([t, n], tf.int32),
             vec, vec, vec, vec, vec, vec, tf.TensorSpec([cfg.epochs, t * n], tf.int32)])
 
@@ -184,8 +184,11 @@ class PPOAgent:
         per_epoch = size // cfg.minibatch
         planned = cfg.epochs * per_epoch
         kl_limit = 1.5 * cfg.target_kl if cfg.target_kl > 0 else float("inf")
-        sums, evaluated, taken = tf.zeros([len(LOSS_NAMES)]), tf.constant(0), tf.constant(0)
-        for step in tf.range(planned):
+        variables = self.model.trainable_variables
+
+        # One minibatch step of the loop below (written as tf.while_loop, not a Python loop for
+        # AutoGraph to convert: a conversion that fails falls back silently, and the loop then fails).
+        def minibatch(step, sums, evaluated, taken, too_far):
             epoch, k = step // per_epoch, step % per_epoch
             idx = perms[epoch, k * cfg.minibatch:(k + 1) * cfg.minibatch]
             mb_obs, mb_act, mb_logp, mb_adv, mb_tgt = (tf.gather(x, idx) for x in flat)
@@ -193,15 +196,21 @@ class PPOAgent:
                 logits, v = self.model(mb_obs, training=True)
                 losses = ppo_losses(logits, v[:, 0], mb_act, mb_logp, mb_adv, mb_tgt, cfg)
                 total = tf.debugging.check_numerics(losses[0], "PPO loss")
-            sums += tf.stack(losses)
-            evaluated += 1
-            if losses[APPROX_KL] > kl_limit:  # the policy moved too far from the one that acted: stop here
-                break
-            grads = tape.gradient(total, self.model.trainable_variables)
-            if cfg.max_grad_norm > 0:
-                grads, _ = tf.clip_by_global_norm(grads, cfg.max_grad_norm)
-            self.opt.apply_gradients(zip(grads, self.model.trainable_variables))
-            taken += 1
+            too_far = losses[APPROX_KL] > kl_limit  # the policy moved too far from the one that acted: stop here
+
+            def step_on():
+                grads = tape.gradient(total, variables)
+                if cfg.max_grad_norm > 0:
+                    grads, _ = tf.clip_by_global_norm(grads, cfg.max_grad_norm)
+                self.opt.apply_gradients(zip(grads, variables))
+                return taken + 1
+
+            taken = tf.cond(too_far, lambda: taken, step_on)
+            return step + 1, sums + tf.stack(losses), evaluated + 1, taken, too_far
+
+        _, sums, evaluated, taken, _ = tf.while_loop(
+            lambda step, sums, evaluated, taken, too_far: tf.logical_and(step < planned, tf.logical_not(too_far)),
+            minibatch, (tf.constant(0), tf.zeros([len(LOSS_NAMES)]), tf.constant(0), tf.constant(0), tf.constant(False)))
         means = sums / tf.cast(evaluated, tf.float32)  # the minibatch that stopped the update counts
         return tf.concat([means, [tf.cast(taken, tf.float32) / planned]], axis=0)
 

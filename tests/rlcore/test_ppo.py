@@ -128,6 +128,25 @@ def test_compiled_update_equals_an_eager_minibatch_loop(target_kl, max_grad_norm
         assert taken == len(steps)
 
 
+def test_the_update_does_not_need_autograph(monkeypatch):
+    """Where AutoGraph cannot convert a function it runs it as written, with a warning the quiet console
+    hides: a Python loop over tf.range then fails ("Iterating over a symbolic tf.Tensor"), as it did once
+    in a `make test` here. The update is a tf.while_loop, built with AutoGraph off: every conversion made
+    to fail, it still trains."""
+    from tensorflow.python.autograph.impl import api as autograph
+
+    def cannot_convert(*args, **kwargs):
+        raise RuntimeError("AutoGraph cannot convert this here")
+
+    monkeypatch.setattr(autograph, "_convert_actual", cannot_convert)
+    tf.keras.utils.set_random_seed(3)
+    agent = PPOAgent(OBS, 5, CFG)
+    before = [w.copy() for w in agent.model.get_weights()]
+    report = agent.update(*_rollout(np.random.default_rng(4)), np.random.default_rng(5))
+    assert report["update_fraction"] == 1.0 and int(agent.opt.iterations) > 0
+    assert any(not np.array_equal(a, b) for a, b in zip(before, agent.model.get_weights()))
+
+
 def test_update_raises_the_probability_of_advantaged_actions():
     tf.keras.utils.set_random_seed(0)
     cfg = dataclasses.replace(CFG, entropy_coef=0.0, value_coef=0.0, epochs=10, lr=3e-3)
