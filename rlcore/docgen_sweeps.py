@@ -28,6 +28,13 @@ def _runs(folder: str) -> list[tuple[dict, object]]:
     return sorted(runs, key=lambda run: run[0]["seed"])
 
 
+def _kept_sweeps(experiment: str):
+    """(shipped model, its kept sweep's runs) for each shipped model of ``experiment`` with a kept sweep."""
+    for m in docgen_data.shipped_models():
+        if m.experiment == experiment and m.sweep is not None:
+            yield m, _runs(m.sweep.folder)
+
+
 def collapses_cell(collapses: list) -> str:
     """``2: 40k → 58k, 124k → 138k`` (``never`` for one not recovered); ``none``."""
     if not collapses:
@@ -41,10 +48,7 @@ def sweep_stability(page: str, experiment: str) -> str:
     from rlcore.docgen import link, sweep_score, table
 
     parts = []
-    for m in docgen_data.shipped_models():
-        if m.experiment != experiment or m.sweep is None:
-            continue
-        runs = _runs(m.sweep.folder)
+    for m, runs in _kept_sweeps(experiment):
         if not any(st.evaluations for _, st in runs):
             parts.append(f"**[{m.name}]({link(page, m.sweep.folder + '/report.md')})**: its runs made no periodic "
                          f"evaluations; each model holds its run's last weights.")
@@ -76,10 +80,7 @@ def seed_summary(page: str, experiment: str) -> str:
     from rlcore.docgen import iqm_text, link, score_text
 
     parts = []
-    for m in docgen_data.shipped_models():
-        if m.experiment != experiment or m.sweep is None:
-            continue
-        runs = _runs(m.sweep.folder)
+    for m, runs in _kept_sweeps(experiment):
         per_seed = "; ".join(f"{meta['seed']}: {evaluation_cell(meta['evaluation'], m)} after "
                              f"{meta['env_steps']:,} env steps, {_hours(meta['wall_seconds'])}" for meta, _ in runs)
         parts.append(f"{m.title}, the same recipe over {len(m.sweep.seeds)} seeds "
@@ -111,11 +112,9 @@ def seed_runs(page: str, experiment: str) -> str:
     from rlcore.docgen import link, score_text, table
 
     parts = []
-    for m in docgen_data.shipped_models():
-        if m.experiment != experiment or m.sweep is None:
-            continue
+    for m, runs in _kept_sweeps(experiment):
         rows = []
-        for meta, _ in _runs(m.sweep.folder):
+        for meta, _ in runs:
             ev = meta.get("evaluation") or {}
             further = "; ".join(f"{evaluation_cell(f, m)} ({f.get('seeds')})"
                                 for f in meta.get("further_evaluations", [])) or "–"
