@@ -144,11 +144,33 @@ def _keep_into(dest: Path, pairs: list[tuple[Path, str]], sweep: dict | None = N
 BUDGETS = ("max_env_steps", "max_episodes")
 
 
+def check_one_recipe_throughout(run_dir: Path, meta: dict) -> None:
+    """Refuse a run that did not follow one recipe from random weights to its end: one started from a
+    model's weights (``--init-from``), or resumed with a hyperparameter other than a :data:`BUDGETS` changed
+    (read from meta.json's ``command_starts``, where each resume records what it changed), or a resume
+    whose record predates that."""
+    if meta.get("init_from"):
+        source = meta["init_from"].get("path", "a model") if isinstance(meta["init_from"], dict) else meta["init_from"]
+        raise UserError(f"{run_dir} started from the weights of {source} (--init-from): kept runs train from "
+                        f"random weights")
+    starts = meta.get("command_starts") or []
+    for number, start in enumerate(starts[1:], 2):
+        if not isinstance(start, dict) or "changed" not in start:
+            raise UserError(f"{run_dir}: its meta.json does not say what its command {number} (a resume) changed "
+                            f"(a record from before 2026-11-27): kept runs must show that a resume gave budgets only")
+        changed = {name: values for name, values in start["changed"].items() if name not in BUDGETS}
+        if changed:
+            what = ", ".join(f"{name} {before} -> {after}" for name, (before, after) in sorted(changed.items()))
+            raise UserError(f"{run_dir} was resumed at env step {start['env_steps']:,} with {what}: kept runs follow "
+                            f"one recipe from start to end (a resume may give budgets again, nothing else)")
+
+
 def keep_runs(run_dirs: list[Path], dest: Path) -> Path:
     """Keep single runs of one recipe over seeds (``main.py train ... --seed S``, one run folder each) as
     a sweep would be kept: per run :data:`KEPT_FILES` into ``dest/seed=S/``, and a ``sweep.json`` naming
     the experiment, algorithm, preset, seeds and (for Mario) the level, so that ``report`` and the docs
-    generator read ``dest`` like any kept sweep. The runs must differ in their seed (and :data:`BUDGETS`) only."""
+    generator read ``dest`` like any kept sweep. The runs must differ in their seed (and :data:`BUDGETS`) only,
+    and each must have kept its recipe throughout (:func:`check_one_recipe_throughout`)."""
     from rlcore.experiment import get_experiment
     from rlcore.hparams import to_dict
 
@@ -156,6 +178,7 @@ def keep_runs(run_dirs: list[Path], dest: Path) -> Path:
     metas = [json.loads((d / "model" / "meta.json").read_text()) for d in run_dirs]
     first = metas[0]
     for d, meta in zip(run_dirs, metas):
+        check_one_recipe_throughout(d, meta)
         what = (meta.get("experiment"), meta.get("algo"), meta.get("preset"))
         if what != (first.get("experiment"), first.get("algo"), first.get("preset")):
             raise UserError(f"{d} is a run of {' '.join(map(str, what))}, {run_dirs[0]} of {first.get('experiment')} "

@@ -19,7 +19,7 @@ from typing import Callable
 
 from rlcore.experiment import get_experiment
 from rlcore.errors import UserError
-from rlcore.hparams import apply_overrides, check_no_inert, check_same_run, from_dict
+from rlcore.hparams import apply_overrides, check_no_inert, check_same_run, from_dict, to_dict
 from rlcore.trainers.spec import RunSpec, check_resumable
 
 
@@ -42,6 +42,8 @@ def build_spec(experiment: str, algo: str, *, preset: str | None = None, seed: i
         check_same_run(recorded, overrides, exp.env_fields, run_dir)
         spec.config = apply_overrides(recorded, overrides)
         check_no_inert(spec.config, overrides)
+        before, after = to_dict(recorded), to_dict(spec.config)
+        spec.changes = {name: [before[name], after[name]] for name in overrides if before[name] != after[name]}
         if preset is not None and preset != state["preset"]:
             raise UserError(f"--preset {preset} cannot change on --resume: the run in {run_dir} was started "
                             f"from the {state['preset']} preset")

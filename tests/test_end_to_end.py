@@ -62,7 +62,8 @@ def test_mario_ppo_through_the_process_pool_survives_kill_9_and_resumes(tmp_path
     final = read_checkpoint_state(run_dir / "checkpoint.npz")
     assert final["rollouts"] == state["rollouts"] + 2
     assert final["command_starts"][-1] == {"env_steps": state["env_steps"], "episodes": len(state["returns"]),
-                                           "rollouts": state["rollouts"]}
+                                           "rollouts": state["rollouts"],
+                                           "changed": {"max_env_steps": [100000, budget]}}  # what the resume changed
     # the resumed pool got the routes back and kept them (the envs replay them from the level's start)
     assert {name.split("/")[3] for name in route_keys(run_dir / "checkpoint.npz")} >= \
         {name.split("/")[3] for name in routes}

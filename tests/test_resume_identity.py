@@ -66,6 +66,10 @@ def test_resume_may_change_budgets_rates_and_coefficients(tmp_path):
     spec = build_spec("lunar_lander", "dqn", run_dir=folder, resume=True,
                       overrides={"lr": 1e-4, "max_episodes": 50, "tau": 0.01, "hidden": get_experiment("lunar_lander").preset("dqn", None).hidden})
     assert (spec.config.lr, spec.config.max_episodes, spec.config.tau) == (1e-4, 50, 0.01)
+    # what the resume changed, for meta.json (a defining field given with its recorded value changed nothing)
+    preset = get_experiment("lunar_lander").preset("dqn", None)
+    assert spec.changes == {"lr": [preset.lr, 1e-4], "max_episodes": [preset.max_episodes, 50],
+                            "tau": [preset.tau, 0.01]}
 
 
 @pytest.mark.parametrize("argv, words", [

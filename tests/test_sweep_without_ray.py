@@ -152,12 +152,19 @@ def test_report_tells_each_runs_collapses_and_which_weights_its_model_holds(tmp_
     assert "- seed=2: 1 collapse (3,000: 1.00 after 10.00, not recovered); model: the last weights" in text
 
 
-def _mario_run(folder: Path, seed: int, flags: int, further: int | None = None, **config) -> Path:
-    """A finished Mario 1-1 run folder as `main.py train mario_ppo ppo --seed S` leaves it, written by hand."""
+def _mario_run(folder: Path, seed: int, flags: int, further: int | None = None, resumes: tuple = (),
+               init_from: dict | None = None, **config) -> Path:
+    """A finished Mario 1-1 run folder as `main.py train mario_ppo ppo --seed S` leaves it, written by hand;
+    ``resumes``: what each resume changed (meta.json's ``command_starts[i]["changed"]``, None: not recorded)."""
     (folder / "model").mkdir(parents=True)
+    starts = [{"env_steps": 0, "episodes": 0}] + [
+        {"env_steps": 500 * i, "episodes": 3 * i, **({} if changed is None else {"changed": changed})}
+        for i, changed in enumerate(resumes, 1)]
     meta = {"experiment": "mario_ppo", "algo": "ppo", "preset": "default", "seed": seed, "env_steps": 1000 * (seed + 1),
             "wall_seconds": 10.0, "config": {"world": 1, "stage": 1, "lr": 1e-4, **config},
-            "evaluation": {"episodes": 10, "success_share": flags / 10, "seeds": "1000000..1000009"}}
+            "evaluation": {"episodes": 10, "success_share": flags / 10, "seeds": "1000000..1000009"},
+            "commands": ["python main.py train mario_ppo ppo"] + ["python main.py train mario_ppo ppo --resume"] * len(resumes),
+            "command_starts": starts, "init_from": init_from}
     if further is not None:
         meta["further_evaluations"] = [{"episodes": 30, "success_share": further / 30, "seeds": "1000010..1000039"}]
     (folder / "model" / "meta.json").write_text(json.dumps(meta))
@@ -174,8 +181,10 @@ def test_single_runs_over_seeds_are_kept_and_reported_as_a_sweep_of_their_level(
     # imported before docgen_data.REPO points at tmp_path below: a module imported while it does would keep it
     from rlcore import docgen, docgen_cards, docgen_data, docgen_sweeps  # noqa: F401
 
-    runs = [str(_mario_run(tmp_path / "long_runs" / f"1-1-seed-{s}", s, flags, further, max_env_steps=budget))
-            for s, flags, further, budget in ((0, 9, 27, 10**7), (1, 10, None, 2 * 10**7), (2, 6, 20, 10**7))]
+    budget_again = ({"max_env_steps": [10**7, 2 * 10**7]}, {})  # seed 1 resumed twice: a new budget, then nothing
+    runs = [str(_mario_run(tmp_path / "long_runs" / f"1-1-seed-{s}", s, flags, further, resumes, max_env_steps=budget))
+            for s, flags, further, budget, resumes in ((0, 9, 27, 10**7, ()), (1, 10, None, 2 * 10**7, budget_again),
+                                                       (2, 6, 20, 10**7, ()))]
     kept = tmp_path / "results" / "sweeps" / "mario_ppo__1-1"
     code, out, err = run(capsys, "report", *runs, "--keep", str(kept), "--reps", "200")
     assert code == 0, err
@@ -230,11 +239,21 @@ def test_keeping_again_replaces_the_kept_folder_whole_and_never_another_folder(t
     ("no keep", "is a finished run, not a sweep: to report single runs of one recipe over seeds, keep them"),
     ("other config", "differ in entropy_coef: kept runs are one recipe over seeds"),
     ("same seed", "two of the runs have the same seed (0, 0)"),
-    ("with a sweep", "--keep takes one sweep folder, or finished run folders only, not both")])
+    ("with a sweep", "--keep takes one sweep folder, or finished run folders only, not both"),
+    # the same final settings, but not one recipe from start to end
+    ("init from", "started from the weights of saved_networks/mario_ppo/1-1 (--init-from): kept runs train from random"),
+    ("changed on a resume", "was resumed at env step 1,000 with entropy_coef 0.01 -> 0.003: kept runs follow one recipe"),
+    ("unrecorded resume", "does not say what its command 2 (a resume) changed")])
 def test_single_runs_that_are_not_one_recipe_over_seeds_are_refused(tmp_path, capsys, case, message):
     first = str(_mario_run(tmp_path / "a", 0, 9))
     other = {"other config": lambda: _mario_run(tmp_path / "b", 1, 9, entropy_coef=0.003),
-             "same seed": lambda: _mario_run(tmp_path / "b", 0, 9)}.get(case, lambda: _mario_run(tmp_path / "b", 1, 9))()
+             "same seed": lambda: _mario_run(tmp_path / "b", 0, 9),
+             "init from": lambda: _mario_run(tmp_path / "b", 1, 9, init_from={"path": "saved_networks/mario_ppo/1-1"}),
+             # changed and changed back: the final settings agree, the record does not
+             "changed on a resume": lambda: _mario_run(tmp_path / "b", 1, 9, resumes=(
+                 {}, {"entropy_coef": [0.01, 0.003]}, {"entropy_coef": [0.003, 0.01]})),
+             "unrecorded resume": lambda: _mario_run(tmp_path / "b", 1, 9, resumes=(None,)),
+             }.get(case, lambda: _mario_run(tmp_path / "b", 1, 9))()
     argv = ["report", first, str(other), "--keep", str(tmp_path / "kept")]
     if case == "no keep":
         argv = argv[:-2]

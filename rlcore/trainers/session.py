@@ -51,13 +51,16 @@ class TrainingSession:
         self.env_steps = int(state.get("env_steps", 0))
         self._wall_before, self._started = float(state.get("wall_seconds", 0.0)), time.perf_counter()
         # the command that started the run, then one per resume; beside each, where it took effect
-        # (None for the commands of checkpoints written before 2026-11-27, which did not record it)
+        # (None for the commands of checkpoints written before 2026-11-27, which did not record it) and,
+        # for a resume, the hyperparameters it changed (``changed``: name -> [before, after]; recorded
+        # from 2026-11-27 on; `report --keep` of single runs reads it)
         earlier = list(state.get("commands", []))
         starts = list(state.get("command_starts") or [])
         self.commands = earlier + [spec.command]
         self.command_starts = ([None] * (len(earlier) - len(starts)) + starts
                                + [{"env_steps": self.env_steps, "episodes": self.book.episodes,
-                                   **({"rollouts": int(state["rollouts"])} if "rollouts" in state else {})}])
+                                   **({"rollouts": int(state["rollouts"])} if "rollouts" in state else {}),
+                                   **({"changed": dict(spec.changes)} if resumed_state else {})}])
         self.evaluation = PeriodicEvaluation(cfg, state)
         self.evaluation.restore_best_arrays(resumed_arrays or {})
         self.stop = StopRequest(spec.stop_file)

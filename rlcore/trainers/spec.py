@@ -35,6 +35,9 @@ class RunSpec:
     on_progress: Callable[[dict, str], None] | None = None
     # a file whose appearance stops the run at its next safe point, with a checkpoint (sweeps' Ctrl-C)
     stop_file: Path | None = None
+    # a resume's hyperparameters that differ from its checkpoint's, name -> [before, after] (JSON values):
+    # meta.json keeps them beside the command, so a run's settings can be followed from start to end
+    changes: dict = field(default_factory=dict)
 
     @property
     def kind(self) -> str:
