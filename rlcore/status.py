@@ -29,7 +29,7 @@ def run_status(run_dir: str | Path, experiment, about: dict, block: int = 200,
     them, then the commonest causes of failure over those blocks' span (all episodes), then the last
     ``blocks`` blocks of ``rollout_block`` rollouts, then the last periodic evaluations."""
     df = read_table(Path(run_dir) / "metrics.csv", "episode", "env_steps", "total_points")
-    lines = [headline(about)]
+    lines = [headline(about)] + resumes_lines(about)
     full = full_episodes(df, experiment.curriculum.partial_key if experiment.curriculum else None)
     recent = full.tail(block * blocks)
     if recent.empty:
@@ -53,6 +53,29 @@ def headline(about: dict) -> str:
     if "stopped_by" in about:
         text += f"; stopped by {about['stopped_by']}"
     return text
+
+
+def resumes_lines(about: dict) -> list[str]:
+    """Where the run was resumed and what each resume changed (``command_starts``), so a run meant to
+    follow one recipe shows that it did: none for a run never resumed."""
+    resumes = (about.get("command_starts") or [None])[1:]
+    if not resumes:
+        return []
+    at = [f"{start['env_steps']:,}" if isinstance(start, dict) else "?" for start in resumes]
+    changes = [f"{name} {_value(before)} -> {_value(after)} at {where}"
+               for where, start in zip(at, resumes) if isinstance(start, dict)
+               for name, (before, after) in sorted((start.get("changed") or {}).items())]
+    unrecorded = sum(not isinstance(start, dict) or "changed" not in start for start in resumes)
+    said = ["changed " + "; ".join(changes) if changes else "no setting changed"] if unrecorded < len(resumes) else []
+    if unrecorded:
+        who = "it" if len(resumes) == 1 else "they" if unrecorded == len(resumes) else f"{unrecorded} of them"
+        said.append(f"what {who} changed is not recorded "
+                    f"(resumes recorded it from 2026-11-27 on)")
+    return [f"resumed {len(resumes)} time{'s' * (len(resumes) > 1)} (at env step {', '.join(at)}): " + "; ".join(said)]
+
+
+def _value(value) -> str:
+    return f"{value:.3g}" if isinstance(value, float) else str(value)
 
 
 def block_line(experiment, part: pd.DataFrame, partial: pd.DataFrame | None) -> str:

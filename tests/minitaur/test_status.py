@@ -26,3 +26,27 @@ def test_status_of_a_minitaur_run_shows_length_distance_and_the_last_evaluations
     assert lines[3:] == ["evaluation at env step 4,000: mean 1.25 +- 0.50, 10% of its episodes to the time limit",
                          "evaluation at env step 6,000: mean 2.00 +- 1.00, 30% of its episodes to the time limit",
                          "evaluation at env step 8,000: mean 3.50 +- 1.50, 60% of its episodes to the time limit"]
+
+
+def test_status_says_where_a_run_was_resumed_and_what_each_resume_changed(capsys, tmp_path):
+    """A run meant to follow one recipe shows whether it did (meta.json's or the checkpoint's command_starts)."""
+    from rlcore.status import resumes_lines
+
+    first = {"env_steps": 0, "episodes": 0}
+    assert resumes_lines({"command_starts": [first]}) == [] and resumes_lines({}) == []
+    assert resumes_lines({"command_starts": [first, {"env_steps": 5000, "episodes": 9, "changed": {}}]}) == [
+        "resumed 1 time (at env step 5,000): no setting changed"]
+    starts = [first, {"env_steps": 5000, "episodes": 9, "changed": {"max_env_steps": [10000, 20000]}},
+              {"env_steps": 12000, "episodes": 20, "changed": {"lr": [0.0003, 0.00015], "tau": [0.005, 0.01]}},
+              None, {"env_steps": 15000, "episodes": 30}]  # None / no "changed": records from before they were kept
+    assert resumes_lines({"command_starts": starts}) == [
+        "resumed 4 times (at env step 5,000, 12,000, ?, 15,000): changed max_env_steps 10000 -> 20000 at 5,000; "
+        "lr 0.0003 -> 0.00015 at 12,000; tau 0.005 -> 0.01 at 12,000; what 2 of them changed is not recorded "
+        "(resumes recorded it from 2026-11-27 on)"]
+    # and the command prints it under the headline
+    (tmp_path / "metrics.csv").write_text("episode,total_points,env_steps\n1,0.5,100\n")
+    save_checkpoint(tmp_path / "checkpoint.npz", {}, {}, {
+        "experiment": "minitaur", "algo": "sac", "preset": "default", "seed": 0, "config": {"window": 10},
+        "env_steps": 100, "returns": [0.5], "command_starts": starts[:2]})
+    assert status_lines(capsys, tmp_path)[1] == ("resumed 1 time (at env step 5,000): changed max_env_steps "
+                                                 "10000 -> 20000 at 5,000")
