@@ -94,3 +94,14 @@ def test_every_shipped_model_has_a_card():
         assert card.is_file(), f"{meta.parent} has no model card"
         head = card.read_text().split("---")[1]
         assert "library_name: keras" in head and "model-index:" in head
+
+
+def test_the_layout_page_names_every_module():
+    """docs/developer/layout.md is where a newcomer finds what each file holds: a module added without a
+    line there is a module they cannot find."""
+    layout = (REPO / "docs" / "developer" / "layout.md").read_text()
+    packages = ["rlcore", "lunar_lander", "cartpole", "mario_ppo", "minitaur"]
+    modules = [path for name in packages for path in sorted((REPO / name).rglob("*.py")) if path.name != "__init__.py"]
+    assert len(modules) > 60
+    missing = [str(path.relative_to(REPO)) for path in modules if path.name not in layout]
+    assert not missing, f"docs/developer/layout.md names no line for {missing}"
