@@ -29,7 +29,8 @@ def run_status(run_dir: str | Path, experiment, about: dict, block: int = 200,
     them, then the commonest causes of failure over those blocks' span (all episodes), then the last
     ``blocks`` blocks of ``rollout_block`` rollouts, then the last periodic evaluations."""
     df = read_table(Path(run_dir) / "metrics.csv", "episode", "env_steps", "total_points")
-    lines = [headline(about)] + resumes_lines(about)
+    pace = pace_text(Path(run_dir) / "metrics.csv", about) if "returns" in about else None  # a checkpoint's
+    lines = [headline(about) + (f"; {pace}" if pace else "")] + resumes_lines(about)
     full = full_episodes(df, experiment.curriculum.partial_key if experiment.curriculum else None)
     recent = full.tail(block * blocks)
     if recent.empty:
@@ -72,6 +73,31 @@ def resumes_lines(about: dict) -> list[str]:
         said.append(f"what {who} changed is not recorded "
                     f"(resumes recorded it from 2026-11-27 on)")
     return [f"resumed {len(resumes)} time{'s' * (len(resumes) > 1)} (at env step {', '.join(at)}): " + "; ".join(said)]
+
+
+def pace_text(metrics_csv: Path, about: dict, span_seconds: float = 1800.0) -> str | None:
+    """A run in progress: its env steps per second over the last ``span_seconds`` of its training clock
+    (``metrics.csv``'s ``wall_seconds``, which a resume carries on), and the hours left at that pace to its
+    env-step budget, at most (a stop rule may end it sooner). None for a table without that clock."""
+    if not Path(metrics_csv).is_file():
+        return None
+    df = read_table(metrics_csv, "env_steps")
+    if "wall_seconds" not in df or len(df) < 2:
+        return None
+    recent = df[df["wall_seconds"] >= df["wall_seconds"].iloc[-1] - span_seconds]
+    recent = recent if len(recent) >= 2 else df.tail(2)
+    seconds = float(recent["wall_seconds"].iloc[-1] - recent["wall_seconds"].iloc[0])
+    steps = float(recent["env_steps"].iloc[-1] - recent["env_steps"].iloc[0])
+    if seconds <= 0 or steps <= 0:
+        return None
+    rate = steps / seconds
+    text = f"{rate:,.0f}" if rate >= 10 else f"{rate:.2g}"
+    text += " env steps/s lately"
+    budget = (about.get("config") or {}).get("max_env_steps")
+    done = about.get("env_steps", int(df["env_steps"].iloc[-1]))
+    if budget and budget < 10**9 and budget > done:
+        text += f", at most {(budget - done) / rate / 3600:.1f} h to its budget of {budget:,} env steps"
+    return text
 
 
 def _value(value) -> str:
@@ -217,8 +243,10 @@ def sweep_status(folder: str | Path) -> list[str]:
         elif (trial / CHECKPOINT_FILE).is_file():
             state = read_checkpoint_state(trial / CHECKPOINT_FILE)
             last = evaluation_lines(trial / "evals.csv", last=1)
+            pace = pace_text(trial / "metrics.csv", state)
             lines.append(f"  {name}: checkpoint at {state['env_steps']:,} env steps, "
-                         f"{state.get('wall_seconds', 0) / 3600:.1f} h" + (f"; last {last[0]}" if last else ""))
+                         f"{state.get('wall_seconds', 0) / 3600:.1f} h" + (f", {pace}" if pace else "")
+                         + (f"; last {last[0]}" if last else ""))
         else:
             lines.append(f"  {name}: not started")
     return lines

@@ -50,3 +50,15 @@ def test_status_says_where_a_run_was_resumed_and_what_each_resume_changed(capsys
         "env_steps": 100, "returns": [0.5], "command_starts": starts[:2]})
     assert status_lines(capsys, tmp_path)[1] == ("resumed 1 time (at env step 5,000): changed max_env_steps "
                                                  "10000 -> 20000 at 5,000")
+
+
+def test_status_of_a_run_in_progress_gives_its_pace_and_the_hours_left_to_its_budget(capsys, tmp_path):
+    # 1,000 env steps a second for the last half hour of its clock (the row before it, slower, is older)
+    (tmp_path / "metrics.csv").write_text("episode,total_points,env_steps,wall_seconds\n1,0.5,100,100\n"
+                                          "2,0.5,200000,1800\n3,0.5,2000000,3600\n")
+    save_checkpoint(tmp_path / "checkpoint.npz", {}, {}, {
+        "experiment": "minitaur", "algo": "sac", "preset": "default", "seed": 0,
+        "config": {"window": 10, "max_env_steps": 9_200_000}, "env_steps": 2_000_000, "returns": [0.5] * 3,
+        "wall_seconds": 3600.0})
+    assert status_lines(capsys, tmp_path)[0].endswith(
+        "1.0 h of training; 1,000 env steps/s lately, at most 2.0 h to its budget of 9,200,000 env steps")
