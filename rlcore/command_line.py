@@ -184,7 +184,7 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
     report = sub.add_parser("report", help="results of sweeps: per run, and mean / median / IQM with 95%% CIs",
                             description="Per run: the final evaluation on unseen seeds, env steps, wall time, "
                                         "and what its periodic evaluations saw (collapses, the weights kept). "
-                                        "Over runs: mean, median and IQM with 95%% stratified bootstrap CIs "
+                                        "Over runs: mean, median and IQM with 95% stratified bootstrap CIs "
                                         "(rliable's method); with two sweeps, P(first beats second). Writes "
                                         "report.md, report_curves.png and, where runs evaluated periodically, "
                                         "report_evals.png into the first sweep folder.")
@@ -196,7 +196,8 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
                         help="first copy sweep.json and, per run, model/meta.json, the model's .h5 files and "
                              "its CSV tables (not the checkpoints) into DIR, a folder git keeps such as "
                              "results/sweeps/NAME, and write the report there; run folders go to DIR/seed=S "
-                             "with a sweep.json written for them")
+                             "with a sweep.json written for them, each refused unless it followed one recipe "
+                             "from random weights (no --init-from; its resumes changed budgets only)")
 
     plot = sub.add_parser("plot", help="write the training plots of a run folder (running, interrupted "
                                        "or finished)",
@@ -215,7 +216,10 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
                                         "goal (Minitaur), the mean episode length and metres walked; "
                                         "for PPO, per block of rollouts, the same shares beside "
                                         "the update sizes, learning rate and entropy weight; "
-                                        "then the last periodic evaluations.")
+                                        "then the last periodic evaluations. Under the first line: a run "
+                                        "in progress's env steps/s lately and the hours left at that pace "
+                                        "to its env-step budget, and where the run was resumed and what "
+                                        "each resume changed.")
     status.add_argument("run_dir", help="a run folder, e.g. long_runs/mario_ppo/2-2, or a sweep's folder "
                                         "(a line per trial)")
     status.add_argument("--block", type=COUNT, default=200, help="episodes per block (default 200)")

@@ -76,7 +76,7 @@ def hyperparameters_page() -> str:
                 allowed = f.metadata.get("allowed")
                 rows.append([f"`--{f.name.replace('_', '-')}`", *shown,
                              allowed.describe() if allowed is not None else "true or false" if f.type in (bool, "bool") else "",
-                             f.metadata.get("help", "").replace("|", "\\|")])
+                             f.metadata.get("help", "").replace("%%", "%").replace("|", "\\|")])
             parts += [table(["flag", *[f"`{p}`" for p in presets], "allowed", "what it does"], rows), ""]
     return "\n".join(parts)
 
