@@ -260,7 +260,7 @@ def cmd_status(args) -> int:
 
     run_dir = Path(args.run_dir)
     if (run_dir / "sweep.json").is_file():  # a sweep's folder: a line per trial
-        from rlcore.status import sweep_status
+        from rlcore.sweep_status import sweep_status
         print("\n".join(sweep_status(run_dir)))
         return 0
     about = _run_folder(run_dir)

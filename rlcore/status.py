@@ -12,8 +12,6 @@ finished. TensorFlow-free.
 """
 from __future__ import annotations
 
-import json
-import math
 from pathlib import Path
 
 import pandas as pd
@@ -75,10 +73,15 @@ def resumes_lines(about: dict) -> list[str]:
     return [f"resumed {len(resumes)} time{'s' * (len(resumes) > 1)} (at env step {', '.join(at)}): " + "; ".join(said)]
 
 
-def pace_text(metrics_csv: Path, about: dict, span_seconds: float = 1800.0) -> str | None:
+#: a budget this large is no budget (the presets' "until the stop rule" values)
+NO_BUDGET = 10**9
+
+
+def pace(metrics_csv: Path, about: dict, span_seconds: float = 1800.0) -> tuple[float, float | None] | None:
     """A run in progress: its env steps per second over the last ``span_seconds`` of its training clock
-    (``metrics.csv``'s ``wall_seconds``, which a resume carries on), and the hours left at that pace to its
-    env-step budget, at most (a stop rule may end it sooner). None for a table without that clock."""
+    (``metrics.csv``'s ``wall_seconds``, which a resume carries on), and the seconds left at that pace to
+    its env-step budget (None without one), at most: a stop rule may end it sooner. None for a table
+    without that clock."""
     if not Path(metrics_csv).is_file():
         return None
     df = read_table(metrics_csv, "env_steps")
@@ -91,12 +94,21 @@ def pace_text(metrics_csv: Path, about: dict, span_seconds: float = 1800.0) -> s
     if seconds <= 0 or steps <= 0:
         return None
     rate = steps / seconds
-    text = f"{rate:,.0f}" if rate >= 10 else f"{rate:.2g}"
-    text += " env steps/s lately"
     budget = (about.get("config") or {}).get("max_env_steps")
     done = about.get("env_steps", int(df["env_steps"].iloc[-1]))
-    if budget and budget < 10**9 and budget > done:
-        text += f", at most {(budget - done) / rate / 3600:.1f} h to its budget of {budget:,} env steps"
+    left = max(0, budget - done) / rate if budget and budget < NO_BUDGET else None
+    return rate, left
+
+
+def pace_text(metrics_csv: Path, about: dict) -> str | None:
+    """:func:`pace` in words: ``86 env steps/s lately, at most 3.1 h to its budget of 1,000,000 env steps``."""
+    measured = pace(metrics_csv, about)
+    if measured is None:
+        return None
+    rate, left = measured
+    text = (f"{rate:,.0f}" if rate >= 10 else f"{rate:.2g}") + " env steps/s lately"
+    if left:
+        text += f", at most {left / 3600:.1f} h to its budget of {about['config']['max_env_steps']:,} env steps"
     return text
 
 
@@ -220,33 +232,3 @@ def _partial_between(df: pd.DataFrame, experiment, part: pd.DataFrame) -> pd.Dat
         return None
     between = df["episode"].between(part["episode"].iloc[0], part["episode"].iloc[-1])
     return df[between & (df[key] == 1)]
-
-
-def sweep_status(folder: str | Path) -> list[str]:
-    """What ``main.py status SWEEP`` prints: the sweep, then a line per trial (finished with its final
-    score, stopped or running at a checkpoint with its last periodic evaluation, or not started)."""
-    from rlcore.checkpoint import read_checkpoint_state
-    from rlcore.sweep import Sweep, final_metrics, trial_name
-    from rlcore.trainers.spec import CHECKPOINT_FILE
-
-    sweep = Sweep.load(Path(folder))
-    trials = [trial_name(t) for t in sweep.trials()]
-    lines = [f"sweep {sweep.name}: {sweep.experiment} {sweep.algo}, {len(trials)} trials"]
-    for name in trials:
-        trial = Path(sweep.folder) / name
-        meta = trial / "model" / "meta.json"
-        if meta.is_file():
-            final = final_metrics(json.loads(meta.read_text()))  # as the sweep reports it (Mario: flag share)
-            lines.append(f"  {name}: finished at {final['env_steps']:,} env steps"
-                         + (f", final score {final['final_score']:.2f} on unseen seeds"
-                            if not math.isnan(final["final_score"]) else ""))  # NaN: not evaluated
-        elif (trial / CHECKPOINT_FILE).is_file():
-            state = read_checkpoint_state(trial / CHECKPOINT_FILE)
-            last = evaluation_lines(trial / "evals.csv", last=1)
-            pace = pace_text(trial / "metrics.csv", state)
-            lines.append(f"  {name}: checkpoint at {state['env_steps']:,} env steps, "
-                         f"{state.get('wall_seconds', 0) / 3600:.1f} h" + (f", {pace}" if pace else "")
-                         + (f"; last {last[0]}" if last else ""))
-        else:
-            lines.append(f"  {name}: not started")
-    return lines

@@ -325,7 +325,8 @@ def test_sigterm_to_the_sweeps_process_group_stops_its_trials_at_a_checkpoint(tm
 
 
 def test_status_of_a_sweep_folder_is_a_line_per_trial(tmp_path, capsys):
-    sweep = _sweep(tmp_path, "st", seeds=(0, 1, 2))
+    sweep = _sweep(tmp_path, "st", seeds=(0, 1, 2), max_env_steps=4300)
+    sweep.max_concurrent = 1
     Path(sweep.folder).mkdir()
     sweep.save()
     done = tmp_path / "st" / "seed=0" / "model"
@@ -348,7 +349,10 @@ def test_status_of_a_sweep_folder_is_a_line_per_trial(tmp_path, capsys):
         "  seed=0: finished at 1,200 env steps, final score 9.50 on unseen seeds",
         "  seed=1: checkpoint at 700 env steps, 2.0 h, 0.4 env steps/s lately, at most 2.5 h to its budget of 4,300 "
         "env steps; last evaluation at env step 500: mean 3.25 +- 0.50, 40% of its episodes to the time limit",
-        "  seed=2: not started"]
+        "  seed=2: not started",
+        # seed 1: 3,600 env steps at 0.4/s = 2.5 h; seed 2: 4,300 at seed 0's 20 env steps/s = 0.06 h
+        "about 2.6 h of training left, 1 trial at a time, at the paces seen (1 trial not started, at the finished "
+        "trials' mean pace)"]
 
 
 def test_tune_warns_of_no_slow_report_even_when_imported_before_the_sweep(monkeypatch):
