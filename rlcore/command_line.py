@@ -221,7 +221,7 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
                                         "to its env-step budget, and where the run was resumed and what "
                                         "each resume changed.")
     status.add_argument("run_dir", help="a run folder, e.g. long_runs/mario_ppo/2-2, or a sweep's folder "
-                                        "(a line per trial)")
+                                        "(a line per trial, then the hours of training the sweep has left)")
     status.add_argument("--block", type=COUNT, default=200, help="episodes per block (default 200)")
     status.add_argument("--blocks", type=COUNT, default=6, help="how many of the newest blocks (default 6)")
     status.add_argument("--rollout-block", type=COUNT, default=20,
