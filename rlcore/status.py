@@ -54,9 +54,10 @@ def headline(about: dict) -> str:
     return text
 
 
-def resumes_lines(about: dict) -> list[str]:
+def resumes_lines(about: dict, most: int = 6) -> list[str]:
     """Where the run was resumed and what each resume changed (``command_starts``), so a run meant to
-    follow one recipe shows that it did: none for a run never resumed."""
+    follow one recipe shows that it did: none for a run never resumed; of many, the first and the
+    ``most`` latest."""
     resumes = (about.get("command_starts") or [None])[1:]
     if not resumes:
         return []
@@ -70,7 +71,10 @@ def resumes_lines(about: dict) -> list[str]:
         who = "it" if len(resumes) == 1 else "they" if unrecorded == len(resumes) else f"{unrecorded} of them"
         said.append(f"what {who} changed is not recorded "
                     f"(resumes recorded it from 2026-11-27 on)")
-    return [f"resumed {len(resumes)} time{'s' * (len(resumes) > 1)} (at env step {', '.join(at)}): " + "; ".join(said)]
+    if len(changes) > most:  # a run steered by hand (Mario 2-2: about twenty changes): the latest
+        said[0] = f"changed {len(changes) - most} settings earlier, then " + "; ".join(changes[-most:])
+    shown = ", ".join(at) if len(at) <= most else f"{at[0]}, ..., {', '.join(at[-most + 1:])}"
+    return [f"resumed {len(resumes)} time{'s' * (len(resumes) > 1)} (at env step {shown}): " + "; ".join(said)]
 
 
 #: a budget this large is no budget (the presets' "until the stop rule" values)

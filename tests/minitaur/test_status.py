@@ -62,3 +62,13 @@ def test_status_of_a_run_in_progress_gives_its_pace_and_the_hours_left_to_its_bu
         "wall_seconds": 3600.0})
     assert status_lines(capsys, tmp_path)[0].endswith(
         "1.0 h of training; 1,000 env steps/s lately, at most 2.0 h to its budget of 9,200,000 env steps")
+
+
+def test_status_of_a_run_resumed_many_times_names_the_first_and_latest_resumes():
+    from rlcore.status import resumes_lines
+
+    starts = [{"env_steps": 0, "episodes": 0}] + [
+        {"env_steps": 1000 * i, "episodes": i, "changed": {"lr": [1.0 / i, 1.0 / (i + 1)]}} for i in range(1, 21)]
+    line, = resumes_lines({"command_starts": starts}, most=3)
+    assert line.startswith("resumed 20 times (at env step 1,000, ..., 19,000, 20,000): changed 17 settings earlier, "
+                           "then lr 0.0556 -> 0.0526 at 18,000; lr 0.0526 -> 0.05 at 19,000; lr 0.05 -> 0.0476 at 20,000")
