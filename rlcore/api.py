@@ -4,15 +4,17 @@
 
     run = api.train("Acrobot-v1", "dqn", episodes=200, lr=5e-4)        # any Gymnasium id, or an experiment
     run.evaluation["mean"]                                              # the final unseen-seed evaluation
+    run = api.resume(run, episodes=400)                                 # on from its checkpoint, as --resume
     policy = api.load(("lunar_lander", "dqn"))                          # a shipped model, or any model folder
     action = policy.predict(observation)
     api.evaluate(policy, episodes=20)                                   # -> dict, as `main.py evaluate`
     api.render(policy, "lander.gif")                                    # MP4 or GIF
     api.export(run, "onnx", "exports/acrobot")                          # checked against the Keras model
 
-:func:`train` runs what ``main.py train`` runs (:func:`rlcore.run.train_and_evaluate`): the same
-checked hyperparameters, run folder, checkpoints, CSV tables and model folder, and the same final
-evaluation on unseen seeds written into meta.json, whose ``command`` records this call. A mistake
+:func:`train` and :func:`resume` (:mod:`rlcore.api_train`) run what ``main.py train`` runs
+(:func:`rlcore.run.train_and_evaluate`): the same checked hyperparameters, run folder, checkpoints,
+CSV tables and model folder, and the same final evaluation on unseen seeds written into meta.json,
+whose ``command`` records this call. A mistake
 the user can fix raises :class:`UserError` (one line, as the CLI prints it). TensorFlow is imported
 on the first call that needs it, with its start-up noise dropped; progress bars are widgets in a
 notebook (``tqdm.auto``).
@@ -22,52 +24,27 @@ from __future__ import annotations
 import contextlib
 import os
 import tempfile
-from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Callable, Iterator, Literal, Union
+from typing import TYPE_CHECKING, Any, Iterator, Literal, Union
 
 os.environ.setdefault("TF_CPP_MIN_LOG_LEVEL", "2")  # before anything imports TensorFlow, as main.py does
 import numpy as np
 
+from rlcore.api_train import ProgressCallback, Run, WandbMode, resume, train
 from rlcore.errors import UserError
 from rlcore.experiment import Experiment
+from rlcore.trainers.stopping import Interrupted
 
 if TYPE_CHECKING:
     import gymnasium
 
-__all__ = ["train", "load", "evaluate", "render", "export", "Run", "Policy", "ModelRef", "ProgressCallback",
-           "Experiment", "UserError"]
+__all__ = ["train", "resume", "load", "evaluate", "render", "export", "Run", "Policy", "ModelRef",
+           "ProgressCallback", "WandbMode", "Experiment", "UserError", "Interrupted"]
 
 #: a model: a folder (a model folder, a finished run's folder, or a run in progress), a finished
 #: :class:`Run`, or a shipped model by name: ``("lunar_lander", "dqn")``, ``("mario_ppo", "1-1")``
 ModelRef = Union[str, "os.PathLike[str]", tuple[str, str], "Run"]
-#: ``callback(row, table)``: every row the run logs, as it is logged; ``table`` is ``"metrics"`` (one
-#: row per episode), ``"evals"`` (periodic evaluations) or ``"rollouts"`` (PPO: one row per update)
-ProgressCallback = Callable[[dict[str, Any], str], None]
 ExportFormat = Literal["savedmodel", "tflite", "onnx"]
-WandbMode = Literal["auto", "online", "offline", "off"]
-
-
-@dataclass(frozen=True)
-class Run:
-    """A finished training run: its folder, its model folder and the model's meta.json."""
-    run_dir: Path
-    model_dir: Path
-    meta: dict[str, Any] = field(repr=False)
-
-    @property
-    def evaluation(self) -> dict[str, Any] | None:
-        """The final evaluation on unseen seeds (meta.json's ``evaluation``), None when skipped."""
-        return self.meta.get("evaluation")
-
-    @property
-    def command(self) -> str:
-        """The call that started the run, as meta.json records it."""
-        return str(self.meta["command"])
-
-    def load(self) -> Policy:
-        """The trained policy (:func:`load` of :attr:`model_dir`)."""
-        return load(self.model_dir)
 
 
 class Policy:
@@ -131,76 +108,6 @@ class Policy:
         """Greedy actions for a batch (the interface rlcore's evaluation and video code call)."""
         actions: np.ndarray = self._network(observations)
         return actions
-
-
-# ------------------------------------------------------------------------------- train
-def train(env: str, algo: str, *, preset: str | None = None, seed: int = 0,
-          run_dir: str | os.PathLike[str] | None = None, episodes: int | None = None,
-          steps: int | None = None, final_eval_episodes: int | None = None, wandb: WandbMode = "off",
-          progress: bool = True, callback: ProgressCallback | None = None, **hyperparameters: Any) -> Run:
-    """Train ``algo`` on ``env`` and evaluate it as ``main.py train`` does; return the :class:`Run`.
-
-    ``env``: an experiment of this package (``"lunar_lander"``), any registered Gymnasium id whose
-    spaces fit ``algo`` (``"Acrobot-v1"``), or ``"my_module:MyEnv-v0"`` to import the module that
-    registers it first. ``preset``: a named set of hyperparameters (default ``"default"``; for a
-    Gymnasium id the algorithm's defaults). ``episodes`` / ``steps``: the budget (``max_episodes`` /
-    ``max_env_steps``). ``final_eval_episodes``: episodes on unseen seeds after training (None: the
-    experiment's default, 100; 0: none). ``run_dir``: where the run writes (default
-    ``runs/ENV__ALGO__SEED__TIME``). ``hyperparameters``: any field of the algorithm's config, e.g.
-    ``lr=5e-4, hidden=(128, 128)``; each is checked as the CLI checks it. ``callback(row, table)``
-    sees every logged row. ``progress``: the progress bar and the summary lines.
-    """
-    from rlcore.quiet import load_tensorflow
-    from rlcore.run import budget_overrides, build_spec, check_new_run_dir, train_and_evaluate
-    from rlcore.trainers.spec import new_run_dir
-
-    from rlcore.extras import require_experiment
-
-    require_experiment(env)  # a missing extra (mario, minitaur): one line, before any folder exists
-    load_tensorflow()
-    given = {name: tuple(value) if isinstance(value, list) else value for name, value in hyperparameters.items()}
-    overrides = {**given, **budget_overrides(episodes, steps, given)}
-    folder = Path(run_dir) if run_dir is not None else new_run_dir(env, algo, seed)
-    check_new_run_dir(folder)
-    command = _call("train", [env, algo], dict(preset=preset, seed=seed, run_dir=run_dir, episodes=episodes,
-                                                 steps=steps, final_eval_episodes=final_eval_episodes,
-                                                 **hyperparameters))
-    spec = build_spec(env, algo, preset=preset, seed=seed, overrides=overrides, run_dir=folder,
-                      wandb_mode=wandb, progress=progress, command=command)
-    say: Callable[[str], None] = print if progress else (lambda line: None)
-    say(f"training {env} {algo} ({spec.preset} preset, seed {spec.seed}) -> {folder}")
-    with _quiet_unless(progress):
-        model_dir, meta = train_and_evaluate(spec, final_eval_episodes, on_progress=callback, say=say)
-    return Run(folder, model_dir, meta)
-
-
-def _call(name: str, args: list[Any], kwargs: dict[str, Any]) -> str:
-    """``rlcore.api.train('Acrobot-v1', 'dqn', seed=0, lr=0.0005)``: the call, as meta.json's command
-    (defaults left out, paths as strings)."""
-    defaults = {"preset": None, "run_dir": None, "episodes": None, "steps": None, "final_eval_episodes": None}
-    shown = [repr(a) for a in args] + [f"{k}={str(v)!r}" if isinstance(v, os.PathLike) else f"{k}={v!r}"
-                                       for k, v in kwargs.items() if not (k in defaults and v is None)]
-    return f"rlcore.api.{name}({', '.join(shown)})"
-
-
-@contextlib.contextmanager
-def _quiet_unless(loud: bool) -> Iterator[None]:
-    """With ``progress=False``, the trainer's per-rollout lines and the evaluation line go nowhere."""
-    if loud:
-        yield
-        return
-    import io
-    from contextlib import redirect_stdout
-
-    from tqdm.auto import tqdm
-
-    write = tqdm.write
-    tqdm.write = lambda *args, **kwargs: None
-    try:
-        with redirect_stdout(io.StringIO()):
-            yield
-    finally:
-        tqdm.write = write
 
 
 # ------------------------------------------------------------------------------- load

@@ -1,4 +1,4 @@
-"""The Python API end to end (api.train/load/evaluate/render/export) and the notebook docs/api.ipynb,
+"""The Python API end to end (api.train/resume/load/evaluate/render/export) and the notebook docs/api.ipynb,
 executed as a user would run it (nbclient, a real Jupyter kernel)."""
 import json
 import os
@@ -77,6 +77,26 @@ def test_train_records_the_call_evaluates_and_renders(tmp_path):
         api.render(run, tmp_path / "clip.avi")
 
 
+def test_resume_goes_on_from_the_checkpoint_records_the_call_and_what_it_changed(tmp_path):
+    """api.resume as `main.py train ... --resume`: a stopped run (here: one whose model folder is not written
+    yet) or a finished one given a larger budget goes on from its checkpoint; what the run is may not change."""
+    first = api.train("cartpole", "dqn", run_dir=tmp_path / "run", episodes=3, final_eval_episodes=0, seed=1,
+                      progress=False, lr=5e-4, checkpoint_every=1)
+    rows = []
+    run = api.resume(first, episodes=5, final_eval_episodes=2, progress=False, lr=2.5e-4,
+                     callback=lambda row, table: rows.append(row))
+    assert run.run_dir == first.run_dir and [row["episode"] for row in rows] == [4, 5]
+    meta = run.meta
+    assert meta["commands"] == [first.command, "rlcore.api.resume(" + repr(str(tmp_path / "run"))
+                                + ", episodes=5, final_eval_episodes=2, lr=0.00025)"]
+    assert meta["command_starts"][1]["changed"] == {"max_episodes": [3, 5], "lr": [5e-4, 2.5e-4]}
+    assert (meta["episodes"], meta["seed"], meta["config"]["lr"], meta["evaluation"]["episodes"]) == (5, 1, 2.5e-4, 2)
+    with pytest.raises(UserError, match="hidden"):
+        api.resume(tmp_path / "run", episodes=6, hidden=(8, 8))  # a network of another size is another run
+    with pytest.raises(UserError, match="holds no checkpoint.npz to resume from"):
+        api.resume(tmp_path / "nothing")
+
+
 def test_a_run_in_progress_loads_from_its_checkpoint(tmp_path):
     """A run folder with a checkpoint and no model yet (stopped, or still running): its last checkpoint."""
     from rlcore.run import build_spec, run_training
@@ -107,5 +127,6 @@ def test_notebook_runs(tmp_path, monkeypatch):
                      for o in outputs)
     assert "greedy return" in text and "rlcore.api.train('CartPole-v1', 'ppo'" in text
     assert (tmp_path / "runs" / "notebook_cartpole_ppo" / "model" / "meta.json").is_file()
+    assert "(6144, {'lr': [0.001, 0.0005], 'max_env_steps': [4096, 6144]})" in text  # the resume's cell
     for noise in ("cuInit", "oneDNN custom operations", "absl::InitializeLog"):
         assert noise not in text  # TensorFlow's start-up noise is kept out

@@ -20,6 +20,7 @@ action = policy.predict(np.zeros(8, np.float32))
 result: dict = api.evaluate(run, episodes=5, seed_base=10)
 video = api.render(policy, "x.gif").with_suffix(".mp4")
 record = api.export(run.model_dir, "onnx", "exports/x")
+again: api.Run = api.resume(run, episodes=20, lr=1e-4)
 '''
 WRONG_CODE = '''\
 from rlcore import api
@@ -28,15 +29,17 @@ api.train("Acrobot-v1", "dqn", episodes="ten")
 api.export("saved_networks/lunar_lander/dqn", "pickle", "out")
 api.render(api.load(("lunar_lander", "dqn")), episodes=1.5)
 api.load(42)
+api.resume(42)
 '''
 
 
 def test_public_names_are_listed_and_typed():
     for name in api.__all__:
-        assert getattr(api, name).__module__ in ("rlcore.api", "rlcore.experiment", "rlcore.errors", "typing")
+        assert getattr(api, name).__module__ in ("rlcore.api", "rlcore.api_train", "rlcore.experiment", "rlcore.errors",
+                                                  "rlcore.trainers.stopping", "typing")
     import rlcore.export  # the export code keeps its module name: the API is rlcore.api, not rlcore itself
     assert callable(rlcore.export.export_model) and callable(api.export)
-    for function in (api.train, api.load, api.evaluate, api.render, api.export):
+    for function in (api.train, api.resume, api.load, api.evaluate, api.render, api.export):
         assert "return" in function.__annotations__ and function.__doc__
     assert (ROOT / "rlcore" / "py.typed").is_file()
     assert "rlcore = py.typed" in (ROOT / "setup.cfg").read_text()  # shipped in the wheel
@@ -48,10 +51,10 @@ def test_mypy_over_the_public_api_and_user_code(tmp_path):
     done = subprocess.run(
         [sys.executable, "-m", "mypy", "--config-file", str(ROOT / "tests" / "mypy_api.ini"),
          "--cache-dir", str(Path(tempfile.gettempdir()) / "deeprl-mypy-cache"), "--no-error-summary",
-         "rlcore/api.py", "rlcore/gym_experiment.py", str(tmp_path / "user_ok.py"), str(tmp_path / "user_wrong.py")],
+         "rlcore/api.py", "rlcore/api_train.py", "rlcore/gym_experiment.py", str(tmp_path / "user_ok.py"), str(tmp_path / "user_wrong.py")],
         cwd=ROOT, capture_output=True, text=True, timeout=300)
     errors = [line for line in done.stdout.splitlines() if ": error:" in line]
     outside = [line for line in errors if "user_wrong.py" not in line]
     assert not outside, "\n".join(outside)
     wrong_lines = sorted({int(line.split(":")[1]) for line in errors if "user_wrong.py" in line})
-    assert wrong_lines == [3, 4, 5, 6], done.stdout  # each wrong call caught, on its own line
+    assert wrong_lines == [3, 4, 5, 6, 7], done.stdout  # each wrong call caught, on its own line
