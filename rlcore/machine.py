@@ -38,11 +38,19 @@ def package_versions() -> dict:
 DEFAULT_SETTINGS = {"onednn": True}
 
 
+# environment variables that change TensorFlow's or XLA's float results on one CPU when set (XLA's
+# fast-math and kernel choices, which SAC's XLA-compiled update and any jit_compile model read;
+# TensorFlow's deterministic ops): recorded by value, and only where set, so that a record made with them
+# unset, as every record before 2026-11-27 was, compares equal with a process where they are unset
+NUMERIC_VARIABLES = ("XLA_FLAGS", "TF_XLA_FLAGS", "TF_DETERMINISTIC_OPS")
+
+
 def numeric_settings() -> dict:
     """This process's environment settings that change TensorFlow's numbers on one CPU: whether its
-    oneDNN kernels are on (``TF_ENABLE_ONEDNN_OPTS``, read as TensorFlow reads it)."""
+    oneDNN kernels are on (``TF_ENABLE_ONEDNN_OPTS``, read as TensorFlow reads it), and the
+    :data:`NUMERIC_VARIABLES` that are set."""
     onednn = os.environ.get("TF_ENABLE_ONEDNN_OPTS", "1").strip().lower() not in ("0", "false")
-    return {"onednn": onednn}
+    return {"onednn": onednn, **{name: os.environ[name] for name in NUMERIC_VARIABLES if os.environ.get(name)}}
 
 
 def this_machine() -> dict:

@@ -162,10 +162,24 @@ def test_render_of_a_shipped_model_is_a_decodable_mp4(tmp_path):
 
 
 def test_turning_onednn_off_is_part_of_what_a_record_replays_on(monkeypatch):
-    monkeypatch.delenv("TF_ENABLE_ONEDNN_OPTS", raising=False)
+    for name in ("TF_ENABLE_ONEDNN_OPTS", *machine.NUMERIC_VARIABLES):
+        monkeypatch.delenv(name, raising=False)
     assert machine.this_machine()["settings"] == {"onednn": True}
     for off in ("0", "false", "False"):
         monkeypatch.setenv("TF_ENABLE_ONEDNN_OPTS", off)
         assert machine.this_machine()["settings"] == {"onednn": False}
     recorded = {**machine.this_machine(), "settings": {"onednn": True}}
     assert not machine.replays_exactly(recorded)  # here oneDNN is off: the bar path, not the replay
+
+
+def test_xla_flags_set_in_the_environment_are_part_of_what_a_record_replays_on(monkeypatch):
+    """XLA's fast math changes SAC's compiled numbers: a record made without it does not replay exactly with it."""
+    for name in ("TF_ENABLE_ONEDNN_OPTS", *machine.NUMERIC_VARIABLES):
+        monkeypatch.delenv(name, raising=False)
+    recorded = machine.this_machine()
+    assert recorded["settings"] == {"onednn": True} and machine.replays_exactly(recorded)
+    monkeypatch.setenv("XLA_FLAGS", "--xla_cpu_enable_fast_math=true")
+    assert machine.this_machine()["settings"] == {"onednn": True, "XLA_FLAGS": "--xla_cpu_enable_fast_math=true"}
+    assert not machine.replays_exactly(recorded)
+    monkeypatch.setenv("XLA_FLAGS", "")  # set but empty: as unset
+    assert machine.replays_exactly(recorded)
