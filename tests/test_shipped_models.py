@@ -173,7 +173,8 @@ def test_turning_onednn_off_is_part_of_what_a_record_replays_on(monkeypatch):
 
 
 def test_xla_flags_set_in_the_environment_are_part_of_what_a_record_replays_on(monkeypatch):
-    """XLA's fast math changes SAC's compiled numbers: a record made without it does not replay exactly with it."""
+    """XLA's fast math may change what SAC's compiled update computes: a record made without it is not held to
+    replay exactly with it."""
     for name in ("TF_ENABLE_ONEDNN_OPTS", *machine.NUMERIC_VARIABLES):
         monkeypatch.delenv(name, raising=False)
     recorded = machine.this_machine()
