@@ -18,6 +18,20 @@ if os.environ.get("PYTEST_XDIST_WORKER_COUNT"):
     os.environ.setdefault("TF_NUM_INTEROP_THREADS", str(_share))
 
 
+@pytest.fixture(autouse=True)
+def registry_as_it_was():
+    """Every test leaves the experiment registry as it found it: a test that registers a toy experiment
+    and keeps it (a sweep trial run in-process registers what its driver hands it) would change what a
+    later test on the same worker sees, and which one that is depends on how the files fall to workers
+    (seen: `test_every_experiment_evaluates_above_the_training_seeds` met the toy's seeds, 2026-11-27)."""
+    from rlcore import experiment as registry
+
+    before = dict(registry.EXPERIMENT_MODULES)
+    yield
+    registry.EXPERIMENT_MODULES.clear()
+    registry.EXPERIMENT_MODULES.update(before)
+
+
 @pytest.fixture
 def sac_without_xla(monkeypatch):
     """SAC agents built without XLA: ~2 s less CPU for each of the many short-lived agents of the tests
