@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
 """Issue 49's trainings, one at a time and in order, each resumed where it stopped:
 
-1. the Minitaur SAC sweep over seeds 0-4 (``long_runs/sweeps/minitaur__sac``), until its folder is kept;
-2. Mario 1-1 over seeds 0-2 with the recipe fixed before the first run (README beside this file), each
-   run then evaluated on 30 further unseen seeds, until ``results/sweeps/mario_ppo__1-1`` is kept.
+1. the Minitaur SAC sweep over seeds 0-4 (``long_runs/sweeps/minitaur__sac``, started by hand: the README
+   beside this file), until every trial has finished;
+2. Mario 1-1 over seeds 0-2 with the recipe fixed before the first run (the same README), each run then
+   evaluated on 30 further unseen seeds; nothing once ``results/sweeps/mario_ppo__1-1`` is kept.
 
     .venv/bin/python long_runs/queue.py --dry-run     # the next command, from the folders' state
     setsid nohup .venv/bin/python long_runs/queue.py > /tmp/queue.log 2>&1 &
@@ -11,7 +12,8 @@
 Each step is read from the folders when the step before it ends, so the queue can be stopped and started
 again at any time. Stop it with SIGTERM or Ctrl-C to its process group (``kill -TERM -- -PGID``; the
 queue prints its PGID): the running training writes its checkpoint and exits, and the queue starts
-nothing more. A step that fails stops the queue with that step's exit status. Keeping a finished sweep
+nothing more. A step that fails stops the queue with that step's exit status, and so does a step that
+ends well but leaves the folders as they were (it would run again forever). Keeping a finished sweep
 (``main.py report ... --keep``) and committing it are left to a person, who reads the result first.
 """
 from __future__ import annotations
@@ -25,6 +27,7 @@ import sys
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO))  # rlcore, from this checkout
 MINITAUR = "long_runs/sweeps/minitaur__sac"
 MARIO_KEPT = "results/sweeps/mario_ppo__1-1"
 MARIO_SEEDS = (0, 1, 2)
@@ -40,10 +43,12 @@ def mario_dir(seed: int) -> str:
 def next_command(repo: Path = REPO) -> list[str] | None:
     """The next step's ``main.py`` arguments, from the state of the folders under ``repo``; None when the
     queue has nothing left to run."""
+    from rlcore.sweep import Sweep, trial_name
+
     minitaur = repo / MINITAUR
     if (minitaur / "sweep.json").is_file():
-        seeds = json.loads((minitaur / "sweep.json").read_text())["seeds"]
-        if not all((minitaur / f"seed={s}" / "model" / "meta.json").is_file() for s in seeds):
+        trials = [trial_name(trial) for trial in Sweep.load(minitaur).trials()]
+        if not all((minitaur / name / "model" / "meta.json").is_file() for name in trials):
             return ["sweep", "minitaur", "sac", "--dir", "long_runs/sweeps", "--name", "minitaur__sac", "--resume",
                     "--num-cpus", "1"]
     if (repo / MARIO_KEPT).exists():
@@ -77,12 +82,18 @@ def main(argv: list[str] | None = None) -> int:
                 for number in (signal.SIGINT, signal.SIGTERM)}
     try:
         print(f"queue: pid {os.getpid()}, process group {os.getpgrp()}", flush=True)
+        done = None
         while not stopping and (command := next_command()) is not None:
+            if command == done:  # it ended well and changed nothing: a trial that keeps failing, say
+                print("queue: stopped: python main.py " + " ".join(command) + " ended with status 0 and left "
+                      "the folders as they were; see its output above", flush=True)
+                return 1
             print("queue: python main.py " + " ".join(command), flush=True)
             code = subprocess.call([sys.executable, "main.py", *command], cwd=REPO)
             if code != 0:
                 print(f"queue: stopped, exit status {code}", flush=True)
                 return code
+            done = command
         print("queue: " + ("stopped" if stopping else "nothing left to run"), flush=True)
         return 130 if stopping else 0
     finally:

@@ -225,20 +225,17 @@ def cmd_export(args) -> int:
 
 
 def _run_folder(run_dir: Path) -> dict:
-    """What the run in ``run_dir`` trained: its model's meta.json once finished (or a shipped model
-    folder's own), else its checkpoint's state; a folder with none, or without metrics.csv, is a
-    clear error."""
-    from rlcore.checkpoint import read_checkpoint_state
-    from rlcore.trainers.spec import CHECKPOINT_FILE
+    """What the run in ``run_dir`` trained (:func:`rlcore.status.run_record`: its model's meta.json once
+    finished, its checkpoint's state while training or resumed past its model); a folder with neither,
+    or without metrics.csv, is a clear error."""
+    from rlcore.status import run_record
 
     if not (run_dir / "metrics.csv").is_file():
         raise UserError(f"no metrics.csv in {run_dir}; give a run folder such as runs/<name>")
-    for meta in (run_dir / "model" / "meta.json", run_dir / "meta.json"):
-        if meta.is_file():
-            return json.loads(meta.read_text())
-    if (run_dir / CHECKPOINT_FILE).is_file():
-        return read_checkpoint_state(run_dir / CHECKPOINT_FILE)
-    raise UserError(f"{run_dir} has neither a checkpoint nor a model/meta.json to say what it trained")
+    record = run_record(run_dir)
+    if record is None:
+        raise UserError(f"{run_dir} has neither a checkpoint nor a model/meta.json to say what it trained")
+    return record
 
 
 def cmd_plot(args) -> int:

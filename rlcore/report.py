@@ -144,6 +144,14 @@ def _keep_into(dest: Path, pairs: list[tuple[Path, str]], sweep: dict | None = N
 BUDGETS = ("max_env_steps", "max_episodes")
 
 
+def command_starts(record: dict) -> list:
+    """A run's ``command_starts`` (meta.json's or a checkpoint's), one per command it records: None for
+    the commands of records from before 2026-11-27, which did not keep it."""
+    starts = list(record.get("command_starts") or [])
+    commands = record.get("commands") or []
+    return [None] * (len(commands) - len(starts)) + starts
+
+
 def check_one_recipe_throughout(run_dir: Path, meta: dict) -> None:
     """Refuse a run that did not follow one recipe from random weights to its end: one started from a
     model's weights (``--init-from``), or resumed with a hyperparameter other than a :data:`BUDGETS` changed
@@ -153,8 +161,7 @@ def check_one_recipe_throughout(run_dir: Path, meta: dict) -> None:
         source = meta["init_from"].get("path", "a model") if isinstance(meta["init_from"], dict) else meta["init_from"]
         raise UserError(f"{run_dir} started from the weights of {source} (--init-from): kept runs train from "
                         f"random weights")
-    starts = meta.get("command_starts") or []
-    for number, start in enumerate(starts[1:], 2):
+    for number, start in enumerate(command_starts(meta)[1:], 2):
         if not isinstance(start, dict) or "changed" not in start:
             raise UserError(f"{run_dir}: its meta.json does not say what its command {number} (a resume) changed "
                             f"(a record from before 2026-11-27): kept runs must show that a resume gave budgets only")

@@ -12,6 +12,7 @@ finished. TensorFlow-free.
 """
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import pandas as pd
@@ -58,9 +59,15 @@ def resumes_lines(about: dict, most: int = 6) -> list[str]:
     """Where the run was resumed and what each resume changed (``command_starts``), so a run meant to
     follow one recipe shows that it did: none for a run never resumed; of many, the first and the
     ``most`` latest."""
-    resumes = (about.get("command_starts") or [None])[1:]
+    from rlcore.report import command_starts
+
+    resumes = command_starts(about)[1:]
     if not resumes:
         return []
+    times = f"resumed {len(resumes)} time{'s' * (len(resumes) > 1)}"
+    if not any(isinstance(start, dict) for start in resumes):  # a record from before 2026-11-27
+        return [f"{times}; where and what {'it' if len(resumes) == 1 else 'they'} changed is not recorded "
+                f"(runs recorded it from 2026-11-27 on); the commands are in meta.json"]
     at = [f"{start['env_steps']:,}" if isinstance(start, dict) else "?" for start in resumes]
     changes = [f"{name} {_value(before)} -> {_value(after)} at {where}"
                for where, start in zip(at, resumes) if isinstance(start, dict)
@@ -74,7 +81,24 @@ def resumes_lines(about: dict, most: int = 6) -> list[str]:
     if len(changes) > most:  # a run steered by hand (Mario 2-2: about twenty changes): the latest
         said[0] = f"changed {len(changes) - most} settings earlier, then " + "; ".join(changes[-most:])
     shown = ", ".join(at) if len(at) <= most else f"{at[0]}, ..., {', '.join(at[-most + 1:])}"
-    return [f"resumed {len(resumes)} time{'s' * (len(resumes) > 1)} (at env step {shown}): " + "; ".join(said)]
+    return [f"{times} (at env step {shown}): " + "; ".join(said)]
+
+
+def run_record(run_dir: str | Path) -> dict | None:
+    """What a run folder says it trained, the newest record first: its checkpoint's state when that is
+    past its model (a run in progress, or a finished run resumed with a larger budget), else its model's
+    meta.json (or a shipped model folder's own); None when it holds neither."""
+    from rlcore.checkpoint import read_checkpoint_state
+    from rlcore.trainers.spec import CHECKPOINT_FILE
+
+    run_dir = Path(run_dir)
+    meta = next((json.loads(path.read_text()) for path in (run_dir / "model" / "meta.json", run_dir / "meta.json")
+                 if path.is_file()), None)
+    if (run_dir / CHECKPOINT_FILE).is_file():
+        state = read_checkpoint_state(run_dir / CHECKPOINT_FILE)
+        if meta is None or state.get("env_steps", 0) > meta.get("env_steps", 0):
+            return state
+    return meta
 
 
 #: a budget this large is no budget (the presets' "until the stop rule" values)
@@ -89,13 +113,19 @@ def pace(metrics_csv: Path, about: dict, span_seconds: float = 1800.0) -> tuple[
     if not Path(metrics_csv).is_file():
         return None
     df = read_table(metrics_csv, "env_steps")
-    if "wall_seconds" not in df or len(df) < 2:
+    if "wall_seconds" not in df:
+        return None
+    df = df[["env_steps", "wall_seconds"]].dropna()
+    # only the rows since either counter last went back (a table pieced together from two runs)
+    back = ((df["wall_seconds"].diff() < 0) | (df["env_steps"].diff() < 0)).to_numpy().nonzero()[0]
+    df = df.iloc[back[-1]:] if len(back) else df
+    if len(df) < 2:
         return None
     recent = df[df["wall_seconds"] >= df["wall_seconds"].iloc[-1] - span_seconds]
     recent = recent if len(recent) >= 2 else df.tail(2)
     seconds = float(recent["wall_seconds"].iloc[-1] - recent["wall_seconds"].iloc[0])
     steps = float(recent["env_steps"].iloc[-1] - recent["env_steps"].iloc[0])
-    if seconds <= 0 or steps <= 0:
+    if not (seconds > 0 and steps > 0):
         return None
     rate = steps / seconds
     budget = (about.get("config") or {}).get("max_env_steps")
@@ -117,7 +147,9 @@ def pace_text(metrics_csv: Path, about: dict) -> str | None:
 
 
 def _value(value) -> str:
-    return f"{value:.3g}" if isinstance(value, float) else str(value)
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return str(value)
+    return f"{value:,}" if isinstance(value, int) else f"{value:.3g}"
 
 
 def block_line(experiment, part: pd.DataFrame, partial: pd.DataFrame | None) -> str:

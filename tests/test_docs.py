@@ -103,7 +103,15 @@ def test_the_layout_page_names_every_module():
     packages = ["rlcore", "lunar_lander", "cartpole", "mario_ppo", "minitaur"]
     modules = [path for name in packages for path in sorted((REPO / name).rglob("*.py")) if path.name != "__init__.py"]
     assert len(modules) > 60
-    missing = [str(path.relative_to(REPO)) for path in modules if path.name not in layout]
+    def named(path: Path) -> bool:
+        """The file's name on the page, not inside another name (status.py in sweep_status.py); a module of
+        rlcore/agents/ as agents/NAME (trainers/ has modules of the same names, listed by name alone)."""
+        name = re.escape(path.name)
+        if path.parent.name == "agents":
+            return re.search(rf"agents/{name}", layout) is not None
+        return re.search(rf"(?<![\w/]){name}|{path.parent.name}/{name}", layout) is not None
+
+    missing = [str(path.relative_to(REPO)) for path in modules if not named(path)]
     assert not missing, f"docs/developer/layout.md names no line for {missing}"
 
 

@@ -7,6 +7,7 @@ import signal
 from pathlib import Path
 
 from rlcore.command_line import build_parser
+from rlcore.sweep import Sweep
 
 ROOT = Path(__file__).resolve().parents[1]
 spec = importlib.util.spec_from_file_location("long_runs_queue", ROOT / "long_runs" / "queue.py")
@@ -28,7 +29,7 @@ def _finish(folder: Path, **meta):
 def test_the_queue_runs_the_minitaur_sweep_then_each_mario_seed_then_its_further_evaluation(tmp_path):
     sweep = tmp_path / queue.MINITAUR
     sweep.mkdir(parents=True)
-    (sweep / "sweep.json").write_text(json.dumps({"seeds": [0, 1]}))
+    Sweep("minitaur", "sac", "minitaur__sac", str(sweep), [0, 1]).save()
     _finish(sweep / "seed=0")
     steps = [queue.next_command(tmp_path)]
     assert steps[-1][:3] == ["sweep", "minitaur", "sac"] and "--resume" in steps[-1]
@@ -64,6 +65,26 @@ def test_the_queues_mario_command_is_the_recipe_the_docs_give(tmp_path):
     given = _parses(command)
     expected = _parses(shlex.split(line.replace("S", "0"))[2:] + ["--run-dir", queue.mario_dir(0)] + queue.QUIET)
     assert vars(given) == vars(expected)
+
+
+def test_a_sweep_with_a_grid_is_waited_for_by_its_trials_names(tmp_path):
+    sweep = tmp_path / queue.MINITAUR
+    sweep.mkdir(parents=True)
+    Sweep("minitaur", "sac", "minitaur__sac", str(sweep), [0], {"lr": [1e-3, 3e-4]}).save()
+    _finish(sweep / "seed=0")  # not a trial of this sweep: its trials are lr=...__seed=0
+    assert queue.next_command(tmp_path)[0] == "sweep"
+    for name in ("lr=0.001__seed=0", "lr=0.0003__seed=0"):
+        _finish(sweep / name)
+    assert queue.next_command(tmp_path)[0] == "train"
+
+
+def test_a_step_that_ends_well_but_changes_nothing_stops_the_queue(monkeypatch, capsys):
+    """A sweep whose trial keeps failing exits 0 and leaves it unfinished: the queue would run it forever."""
+    calls = []
+    monkeypatch.setattr(queue, "next_command", lambda: ["sweep", "x", "--resume"])
+    monkeypatch.setattr(queue.subprocess, "call", lambda argv, cwd: calls.append(argv) or 0)
+    assert queue.main([]) == 1 and len(calls) == 1
+    assert "left the folders as they were" in capsys.readouterr().out
 
 
 def test_a_step_that_stops_or_fails_ends_the_queue_with_its_status(monkeypatch, capsys):

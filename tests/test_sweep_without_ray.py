@@ -334,7 +334,8 @@ def test_status_of_a_sweep_folder_is_a_line_per_trial(tmp_path, capsys):
     (done / "meta.json").write_text(json.dumps({"env_steps": 1200, "wall_seconds": 60.0, "evaluation": {"mean": 9.5}}))
     running = tmp_path / "st" / "seed=1"
     running.mkdir()
-    state = {"env_steps": 700, "wall_seconds": 7200.0, "checkpoint_version": 2, "config": {"max_env_steps": 4300}}
+    state = {"env_steps": 700, "wall_seconds": 7200.0, "checkpoint_version": 2, "config": {"max_env_steps": 4300},
+             "returns": [0.0] * 4}
     np.savez(running / "checkpoint.npz", state_json=np.frombuffer(json.dumps(state).encode(), np.uint8))
     # its pace over the last half hour of its clock (rows past the checkpoint count): 720 env steps in 1,800 s,
     # 0.4 env steps/s; the first row, slower, is older; 3,600 env steps to go from the checkpoint: 2.5 h
@@ -351,8 +352,12 @@ def test_status_of_a_sweep_folder_is_a_line_per_trial(tmp_path, capsys):
         "env steps; last evaluation at env step 500: mean 3.25 +- 0.50, 40% of its episodes to the time limit",
         "  seed=2: not started",
         # seed 1: 3,600 env steps at 0.4/s = 2.5 h; seed 2: 4,300 at seed 0's 20 env steps/s = 0.06 h
-        "about 2.6 h of training left, 1 trial at a time, at the paces seen (1 trial not started, at the finished "
-        "trials' mean pace)"]
+        "at most about 2.6 h of training left, 1 trial at a time, at the paces seen (1 trial not started, at the "
+        "finished trials' mean pace)"]
+    (running / "metrics.csv").write_bytes(b"\x00\xff damaged")  # one trial's damaged table: its line says less
+    code, out, err = run(capsys, "status", str(tmp_path / "st"))
+    assert code == 0, err
+    assert out.splitlines()[2] == "  seed=1: checkpoint at 700 env steps, 2.0 h" and len(out.splitlines()) == 4
 
 
 def test_tune_warns_of_no_slow_report_even_when_imported_before_the_sweep(monkeypatch):
@@ -367,3 +372,16 @@ def test_tune_warns_of_no_slow_report_even_when_imported_before_the_sweep(monkey
     monkeypatch.delenv("TUNE_WARN_THRESHOLD_S")
     quiet_tune()
     assert util.warn_if_slow("process_trial_result").threshold == 600
+
+
+def test_a_run_resumed_before_resumes_recorded_their_changes_is_not_kept():
+    """Records from before 2026-11-27 list the commands but no command_starts: the resumes are there, what
+    they changed is not, so the keep cannot show that they changed budgets only."""
+    from rlcore.errors import UserError
+    from rlcore.report import check_one_recipe_throughout, command_starts
+
+    old = {"commands": ["python main.py train mario_ppo ppo --seed 0", "python main.py train mario_ppo ppo --resume R"]}
+    assert command_starts(old) == [None, None]
+    with pytest.raises(UserError, match="does not say what its command 2 \\(a resume\\) changed"):
+        check_one_recipe_throughout(Path("R"), old)
+    check_one_recipe_throughout(Path("R"), {"commands": ["python main.py train mario_ppo ppo --seed 0"]})  # never resumed

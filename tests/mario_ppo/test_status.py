@@ -1,4 +1,5 @@
 """`main.py status RUN_DIR`: where a run stands, from its CSV tables."""
+import json
 from pathlib import Path
 
 import pandas as pd
@@ -52,8 +53,11 @@ def test_status_says_where_the_restarted_episodes_of_a_block_started(capsys, tmp
 def test_status_of_a_shipped_level_reads_its_meta_and_ends_at_its_last_episode(capsys):
     folder = ROOT / "saved_networks" / "mario_ppo" / "1-4"
     # one block of episodes, one of 20 rollouts
-    head, block, rollouts = status_lines(capsys, folder, "--block", "100", "--blocks", "1")
+    head, resumes, block, rollouts = status_lines(capsys, folder, "--block", "100", "--blocks", "1")
     assert head.startswith("mario_ppo ppo (default preset, seed 0): model at 901,120 env steps, ")
+    commands = json.loads((folder / "meta.json").read_text())["commands"]  # trained before resumes said where
+    assert resumes == (f"resumed {len(commands) - 1} times; where and what they changed is not recorded (runs "
+                       f"recorded it from 2026-11-27 on); the commands are in meta.json")
     df = pd.read_csv(folder / "metrics.csv").tail(100)
     wins = df.success.sum()
     assert block.startswith(f"episodes {df.episode.iloc[0]:,}-{df.episode.iloc[-1]:,} ")

@@ -40,7 +40,7 @@ def test_status_says_where_a_run_was_resumed_and_what_each_resume_changed(capsys
               {"env_steps": 12000, "episodes": 20, "changed": {"lr": [0.0003, 0.00015], "tau": [0.005, 0.01]}},
               None, {"env_steps": 15000, "episodes": 30}]  # None / no "changed": records from before they were kept
     assert resumes_lines({"command_starts": starts}) == [
-        "resumed 4 times (at env step 5,000, 12,000, ?, 15,000): changed max_env_steps 10000 -> 20000 at 5,000; "
+        "resumed 4 times (at env step 5,000, 12,000, ?, 15,000): changed max_env_steps 10,000 -> 20,000 at 5,000; "
         "lr 0.0003 -> 0.00015 at 12,000; tau 0.005 -> 0.01 at 12,000; what 2 of them changed is not recorded "
         "(resumes recorded it from 2026-11-27 on)"]
     # and the command prints it under the headline
@@ -49,7 +49,7 @@ def test_status_says_where_a_run_was_resumed_and_what_each_resume_changed(capsys
         "experiment": "minitaur", "algo": "sac", "preset": "default", "seed": 0, "config": {"window": 10},
         "env_steps": 100, "returns": [0.5], "command_starts": starts[:2]})
     assert status_lines(capsys, tmp_path)[1] == ("resumed 1 time (at env step 5,000): changed max_env_steps "
-                                                 "10000 -> 20000 at 5,000")
+                                                 "10,000 -> 20,000 at 5,000")
 
 
 def test_status_of_a_run_in_progress_gives_its_pace_and_the_hours_left_to_its_budget(capsys, tmp_path):
@@ -72,3 +72,48 @@ def test_status_of_a_run_resumed_many_times_names_the_first_and_latest_resumes()
     line, = resumes_lines({"command_starts": starts}, most=3)
     assert line.startswith("resumed 20 times (at env step 1,000, ..., 19,000, 20,000): changed 17 settings earlier, "
                            "then lr 0.0556 -> 0.0526 at 18,000; lr 0.0526 -> 0.05 at 19,000; lr 0.05 -> 0.0476 at 20,000")
+
+
+def test_pace_reads_only_the_rows_since_a_counter_went_back_and_never_says_nan(tmp_path):
+    from rlcore.status import pace
+
+    about = {"env_steps": 3000, "config": {"max_env_steps": 6000}}
+    table = tmp_path / "metrics.csv"
+    # an older run's rows, then a clock that starts again: 100 env steps a second since, not 1,700
+    table.write_text("episode,env_steps,wall_seconds\n1,1000,10\n2,2000,20\n3,2100,1\n4,3000,10\n")
+    assert pace(table, about) == (100.0, 30.0)
+    table.write_text("episode,env_steps,wall_seconds\n1,1000,10\n2,2000,\n")  # the last clock reading missing
+    assert pace(table, about) is None
+    table.write_text("episode,env_steps,wall_seconds\n1,1000,10\n2,1000,20\n")  # no step taken
+    assert pace(table, about) is None
+
+
+def test_a_finished_run_resumed_past_its_model_is_read_from_its_checkpoint(tmp_path):
+    import json
+
+    from rlcore.status import run_record
+
+    assert run_record(tmp_path) is None
+    (tmp_path / "model").mkdir()
+    (tmp_path / "model" / "meta.json").write_text(json.dumps({"env_steps": 100}))
+    assert run_record(tmp_path) == {"env_steps": 100}
+    save_checkpoint(tmp_path / "checkpoint.npz", {}, {}, {"env_steps": 100, "returns": []})  # the model's own
+    assert run_record(tmp_path) == {"env_steps": 100}
+    save_checkpoint(tmp_path / "checkpoint.npz", {}, {}, {"env_steps": 150, "returns": []})  # training on
+    assert run_record(tmp_path)["env_steps"] == 150
+
+
+def test_the_sweeps_hours_left_are_never_fewer_than_its_longest_trials():
+    from rlcore.sweep_status import NOT_STARTED, time_left
+
+    assert time_left([3600.0], [], None, 4) == ["at most about 1.0 h of training left, 4 trials at a time, at the "
+                                                "paces seen"]
+    # two running (1 h, 2 h) and two waiting (1,000 env steps at 1 a second), two at a time: 1.8 h shared
+    # out, but the 2-hour trial alone takes 2 h
+    assert time_left([3600.0, 7200.0, NOT_STARTED, NOT_STARTED], [0.5, 1.5], 1000, 2)[0].startswith(
+        "at most about 2.0 h of training left, 2 trials at a time")
+    # four trials of an hour each, two at a time: 2 h
+    assert time_left([3600.0, 3600.0, NOT_STARTED, NOT_STARTED], [1.0], 3600, 2)[0].startswith(
+        "at most about 2.0 h of training left, 2 trials at a time, at the paces seen (2 trials not started")
+    assert time_left([None, 3600.0], [], None, 1) == []  # a trial whose pace cannot be told
+    assert time_left([NOT_STARTED], [], 1000, 1) == []  # no finished trial to take a pace from
