@@ -94,6 +94,7 @@ def resume(run: str | os.PathLike[str] | Run, *, episodes: int | None = None, st
     """
     from rlcore.checkpoint import read_checkpoint_state
     from rlcore.extras import require_experiment
+    from rlcore.hparams import resuming_changes
     from rlcore.quiet import load_tensorflow
     from rlcore.run import build_spec
     from rlcore.trainers.spec import CHECKPOINT_FILE
@@ -111,7 +112,8 @@ def resume(run: str | os.PathLike[str] | Run, *, episodes: int | None = None, st
     spec = build_spec(env, algo, overrides=_overrides(hyperparameters, episodes, steps), run_dir=folder,
                       resume=True, wandb_mode=wandb, progress=progress, command=command)
     return _train_and_evaluate(spec, f"resuming {folder} at episode {len(state['returns'])}, env step "
-                                     f"{state['env_steps']}", final_eval_episodes, callback, progress)
+                                     f"{state['env_steps']}{resuming_changes(spec.changes)}", final_eval_episodes,
+                               callback, progress)
 
 
 def _overrides(hyperparameters: dict[str, Any], episodes: int | None, steps: int | None) -> dict[str, Any]:

@@ -50,7 +50,7 @@ def _budget_overrides(args, given: dict | None = None) -> dict:
 
 
 def _spec_from_args(args):
-    from rlcore.hparams import overrides_from_args
+    from rlcore.hparams import overrides_from_args, resuming_changes
     from rlcore.run import build_spec, check_new_run_dir
     from rlcore.trainers.spec import latest_run_dir, new_run_dir
 
@@ -63,7 +63,8 @@ def _spec_from_args(args):
         spec = build_spec(args.experiment, args.algo, run_dir=run_dir, resume=True, **common)
         from rlcore.checkpoint import read_checkpoint_state
         state = read_checkpoint_state(run_dir / "checkpoint.npz")
-        print(f"resuming {run_dir} at episode {len(state['returns'])}, env step {state['env_steps']}")
+        print(f"resuming {run_dir} at episode {len(state['returns'])}, env step {state['env_steps']}"
+              + resuming_changes(spec.changes))
         return spec
     run_dir = Path(args.run_dir) if args.run_dir else new_run_dir(args.experiment, args.algo, args.seed or 0)
     check_new_run_dir(run_dir)

@@ -123,3 +123,19 @@ def check_no_inert(cfg, given) -> None:
 
 def _shown(value) -> str:
     return ",".join(map(str, value)) if isinstance(value, tuple) else str(value)
+
+
+def change_text(name: str, before, after) -> str:
+    """``lr 0.0005 -> 0.00025``, ``max_env_steps 1,000,000 -> 2,000,000``: one hyperparameter a resume changed."""
+    def shown(value) -> str:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            return str(value)
+        return f"{value:,}" if isinstance(value, int) else f"{value:.3g}"
+    return f"{name} {shown(before)} -> {shown(after)}"
+
+
+def resuming_changes(changes: dict) -> str:
+    """``; changing lr 0.0005 -> 0.00025``: what a resume changes (``RunSpec.changes``), for the line that
+    announces it; "" when it changes nothing."""
+    return "; changing " + ", ".join(change_text(name, *values) for name, values in changes.items()) if changes else ""
+

@@ -59,6 +59,7 @@ def resumes_lines(about: dict, most: int = 6) -> list[str]:
     """Where the run was resumed and what each resume changed (``command_starts``), so a run meant to
     follow one recipe shows that it did: none for a run never resumed; of many, the first and the
     ``most`` latest."""
+    from rlcore.hparams import change_text
     from rlcore.report import command_starts
 
     resumes = command_starts(about)[1:]
@@ -69,7 +70,7 @@ def resumes_lines(about: dict, most: int = 6) -> list[str]:
         return [f"{times}; where and what {'it' if len(resumes) == 1 else 'they'} changed is not recorded "
                 f"(runs recorded it from 2026-11-27 on); the commands are in meta.json"]
     at = [f"{start['env_steps']:,}" if isinstance(start, dict) else "?" for start in resumes]
-    changes = [f"{name} {_value(before)} -> {_value(after)} at {where}"
+    changes = [f"{change_text(name, before, after)} at {where}"
                for where, start in zip(at, resumes) if isinstance(start, dict)
                for name, (before, after) in sorted((start.get("changed") or {}).items())]
     unrecorded = sum(not isinstance(start, dict) or "changed" not in start for start in resumes)
@@ -144,12 +145,6 @@ def pace_text(metrics_csv: Path, about: dict) -> str | None:
     if left:
         text += f", at most {left / 3600:.1f} h to its budget of {about['config']['max_env_steps']:,} env steps"
     return text
-
-
-def _value(value) -> str:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        return str(value)
-    return f"{value:,}" if isinstance(value, int) else f"{value:.3g}"
 
 
 def block_line(experiment, part: pd.DataFrame, partial: pd.DataFrame | None) -> str:

@@ -209,7 +209,9 @@ def test_ctrl_c_saves_a_checkpoint_and_resume_continues(tmp_path, signal_name, c
     # the resume in this process: nothing signals it
     assert main.main(cmd[2:-4] + ["--resume", str(run_dir), "--episodes", str(episodes_before + 3),
                                   "--final-eval-episodes", "0"]) == 0
-    assert f"resuming {run_dir} at episode {episodes_before}" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert f"resuming {run_dir} at episode {episodes_before}" in out
+    assert "; changing max_episodes " in out and f" -> {episodes_before + 3:,}\n" in out  # what the resume changes
     rows = (run_dir / "metrics.csv").read_text().splitlines()[1:]
     assert [int(r.split(",")[0]) for r in rows] == list(range(1, episodes_before + 4))
 
