@@ -1,4 +1,9 @@
-"""Rollout loop for A2C over the env pool (``num_envs`` envs, in-process or one process each)."""
+"""Rollout loop for A2C over the env pool (``num_envs`` envs, in-process or one process each).
+
+Each step's next observation is kept (a truncated episode's final one in its place,
+:func:`rlcore.vector.bootstrap_observations`) and the update values them all: vector observations are
+small. PPO keeps values instead of observations, for Mario's frames (:class:`rlcore.trainers.ppo.Rollout`).
+"""
 from __future__ import annotations
 
 from functools import partial

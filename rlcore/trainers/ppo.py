@@ -27,7 +27,14 @@ from rlcore.vector import EnvPool
 
 
 class Rollout:
-    """Preallocated [T, N] buffers of one rollout (frames stay uint8)."""
+    """Preallocated [T, N] buffers of one rollout (frames stay uint8).
+
+    A truncated episode is bootstrapped from V of its final observation, as in A2C; only the bookkeeping
+    differs. A2C (:mod:`rlcore.trainers.a2c`) keeps every step's next observation and values them all in
+    its update; for Mario's frames that second [T, N] observation buffer would be 8 x 512 x 84 x 84 x 4
+    bytes, 116 MB more, so PPO keeps V of each next state as it collects (the next step's value) and
+    values only the final observations of the truncated episodes, in one batched call per step.
+    """
 
     def __init__(self, t: int, n: int, obs_shape: tuple, obs_dtype=np.uint8):
         self.obs = np.zeros((t, n, *obs_shape), obs_dtype)
