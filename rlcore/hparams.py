@@ -137,5 +137,6 @@ def change_text(name: str, before, after) -> str:
 def resuming_changes(changes: dict) -> str:
     """``; changing lr 0.0005 -> 0.00025``: what a resume changes (``RunSpec.changes``), for the line that
     announces it; "" when it changes nothing."""
-    return "; changing " + ", ".join(change_text(name, *values) for name, values in changes.items()) if changes else ""
-
+    if not changes:
+        return ""
+    return "; changing " + ", ".join(change_text(name, *values) for name, values in changes.items())
