@@ -207,8 +207,8 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
     plot.add_argument("run_dir", help="a run folder, e.g. runs/mario_ppo__ppo__0__<time>")
     plot.add_argument("--out", default=None, help="folder for the PNGs (default RUN_DIR/plots)")
 
-    status = sub.add_parser("status", help="where a run stands, in a few lines (running, interrupted or "
-                                           "finished)",
+    status = sub.add_parser("status", help="where a run or a sweep stands, in a few lines: its pace, the hours "
+                                           "left, the latest episodes (running, interrupted or finished)",
                             description="Print where a run stands from its CSV tables: per block of "
                                         "episodes that started where evaluations start, the success "
                                         "share, mean progress and mean return, the restarted episodes "
