@@ -35,7 +35,7 @@ class Run:
 
     @property
     def command(self) -> str:
-        """The call that started the run, as meta.json records it."""
+        """The call that started the run, as meta.json records it (every call since: ``meta["commands"]``)."""
         return str(self.meta["command"])
 
     def load(self) -> Policy:
@@ -43,7 +43,6 @@ class Run:
         from rlcore.api import load
 
         return load(self.model_dir)
-
 
 
 def train(env: str, algo: str, *, preset: str | None = None, seed: int = 0,
