@@ -2,10 +2,10 @@
 
 First what the run is and how far it got, with the pace of a run in progress and the hours left at that
 pace to its env-step budget (:func:`pace`), and where it was resumed and what each resume changed
-(:func:`resumes_lines`). Then, for a run that lasts many sessions (a Mario level): per block of episodes that started where
-evaluations start, the success share, the mean progress and the mean return; the episodes that
-started elsewhere (Mario's restarts) beside them, with where they started; and what ended the
-failures. For a run without a goal (Minitaur): per block, the mean return, episode length and info
+(:func:`resumes_lines`). Then, for a run that lasts many sessions (a Mario level): per block of
+episodes that started where evaluations start, the success share, the mean progress and the mean
+return; the episodes that started elsewhere (Mario's restarts) beside them, with where they started;
+and what ended the failures. For a run without a goal (Minitaur): per block, the mean return, episode length and info
 keys (metres walked), and the last periodic evaluations. For a PPO run, per block of rollouts
 (``rollouts.csv``): the same success shares beside the size of PPO's updates (entropy, approx KL,
 clip fraction), the learning rate and the entropy weight, to see what a change of settings did. It
