@@ -137,9 +137,10 @@ def pace(metrics_csv: Path, about: dict, span_seconds: float = 1800.0) -> tuple[
     return rate, left
 
 
-def pace_text(metrics_csv: Path, about: dict) -> str | None:
-    """:func:`pace` in words: ``86 env steps/s lately, at most 3.1 h to its budget of 1,000,000 env steps``."""
-    measured = pace(metrics_csv, about)
+def pace_text(metrics_csv: Path, about: dict, measured: tuple[float, float | None] | None = None) -> str | None:
+    """:func:`pace` in words: ``86 env steps/s lately, at most 3.1 h to its budget of 1,000,000 env steps``
+    (``measured``: what :func:`pace` gave already, so the table is not read again)."""
+    measured = measured or pace(metrics_csv, about)
     if measured is None:
         return None
     rate, left = measured

@@ -42,7 +42,8 @@ def sweep_status(folder: str | Path) -> list[str]:
                             if not math.isnan(final["final_score"]) else ""))  # NaN: not evaluated
             continue
         try:
-            measured, text = pace(trial / "metrics.csv", record), pace_text(trial / "metrics.csv", record)
+            measured = pace(trial / "metrics.csv", record)
+            text = pace_text(trial / "metrics.csv", record, measured)
             last = evaluation_lines(trial / "evals.csv", last=1)
         except UserError:  # a damaged table: the trial's line without what it would have said
             measured, text, last = None, None, []
