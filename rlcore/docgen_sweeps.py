@@ -8,23 +8,26 @@ from __future__ import annotations
 
 from rlcore import docgen_data  # its REPO and shipped_models read at each call (tests point them elsewhere)
 from rlcore.eval_history import stability_summary, steps_text, story
+from rlcore.experiment import get_experiment
 
 #: what the sweep-stability region says before its tables (the rule is rlcore.eval_history's)
 STABILITY_INTRO = ("What the periodic evaluations (on selection seeds) saw through training: a *collapse* is an "
                    "evaluation that falls below a quarter of the way up from the run's first evaluation to its best "
                    "before it, once the run has made half of its best gain; it is *back* at the first evaluation three "
-                   "quarters of the way up again (`rlcore/eval_history.py`).")
+                   "quarters of the way up again. A run whose evaluations never got a quarter of the way from its "
+                   "first to the task's solved score had little to lose, and none of its dips counts "
+                   "(`rlcore/eval_history.py`).")
 SEED_RUNS_INTRO = ("Each seed's run: its score on unseen seeds (and further evaluations on other unseen seeds), env "
                    "steps, wall time and speed on the machine that trained it (its CPU in the report), and what "
                    "ended it.")
 
 
-def _runs(folder: str) -> list[tuple[dict, object]]:
-    """(meta, story) of each finished run of a kept sweep, by seed."""
+def _runs(folder: str, solved: float | None) -> list[tuple[dict, object]]:
+    """(meta, story) of each finished run of a kept sweep, by seed; ``solved``: the task's solved score."""
     runs = []
     for meta_path in (docgen_data.REPO / folder).glob("*/model/meta.json"):
         meta = docgen_data.read_json(meta_path)
-        runs.append((meta, story(meta_path.parent.parent, meta)))
+        runs.append((meta, story(meta_path.parent.parent, meta, solved)))
     return sorted(runs, key=lambda run: run[0]["seed"])
 
 
@@ -32,7 +35,7 @@ def _kept_sweeps(experiment: str):
     """(shipped model, its kept sweep's runs) for each shipped model of ``experiment`` with a kept sweep."""
     for m in docgen_data.shipped_models():
         if m.experiment == experiment and m.sweep is not None:
-            yield m, _runs(m.sweep.folder)
+            yield m, _runs(m.sweep.folder, get_experiment(experiment).solved_score)
 
 
 def collapses_cell(collapses: list) -> str:

@@ -5,14 +5,19 @@ A *collapse* is measured against the run's own scale, so the same rule serves re
 negative (LunarLander) and returns that start near zero (Minitaur). With ``b`` the first evaluation's
 mean and ``g`` the best gain over ``b`` before evaluation ``i``:
 
-- the run has *learnt* once ``g`` is at least ``learnt`` (half) of the best gain it ever makes;
+- a run whose best gain never reaches ``least`` (a quarter) of the way from ``b`` to the task's solved
+  score (``Experiment.solved_score``, where the task has one and ``b`` is below it) had little to
+  lose: its ups and downs are noise on a policy that has not learnt much, not collapses;
+- otherwise the run has *learnt* once ``g`` is at least ``learnt`` (half) of the best gain it ever makes;
 - evaluation ``i`` of a run that has learnt starts a collapse when its mean is below ``b + drop * g``
   (a quarter of the way up from the start);
 - the collapse ends at the first later evaluation back above ``b + recover * g`` (three quarters);
   one that never comes back is unrecovered.
 
 Seed 0 of the Minitaur sweep, for instance: its first evaluation -0.08, then 14.76 at 350k and 0.19 at
-400k (a collapse), back at 12.06 by 500k.
+400k (a collapse), back at 12.06 by 500k. Seed 2 of the same sweep went from -0.34 to 0.86 at 200k and
+-0.07 at 250k, and was still below 1 at 650k: against the solved score 15 it had not learnt to walk, so
+its dips are not collapses.
 """
 from __future__ import annotations
 
@@ -23,7 +28,7 @@ from pathlib import Path
 
 from rlcore.errors import UserError
 
-DROP, RECOVER, LEARNT = 0.25, 0.75, 0.5
+DROP, RECOVER, LEARNT, LEAST = 0.25, 0.75, 0.5, 0.25
 
 
 @dataclass(frozen=True)
@@ -59,15 +64,26 @@ def read_evals(run_dir: Path) -> list[Evaluation]:
     return evals
 
 
-def collapses(evals: list[Evaluation], drop: float = DROP, recover: float = RECOVER,
+def learnt_the_task(evals: list[Evaluation], solved: float | None, least: float = LEAST) -> bool:
+    """Whether the run's best evaluation got ``least`` of the way from its first to ``solved`` (the
+    task's solved score; None, or a first evaluation already at it: any gain counts)."""
+    if not evals:
+        return False
+    means = [e.mean for e in evals]
+    gain = max(means) - means[0]
+    if solved is None or means[0] >= solved:
+        return gain > 0
+    return gain >= least * (solved - means[0])
+
+
+def collapses(evals: list[Evaluation], solved: float | None = None, drop: float = DROP, recover: float = RECOVER,
               learnt: float = LEARNT) -> list[Collapse]:
-    """The collapses of a run's evaluations, by the rule of this module's docstring."""
-    if len(evals) < 2:
-        return []
+    """The collapses of a run's evaluations, by the rule of this module's docstring; ``solved``: the
+    task's solved score, if it has one."""
+    if len(evals) < 2 or not learnt_the_task(evals, solved):
+        return []  # it never learnt anything to lose
     means = [e.mean for e in evals]
     base, total_gain = means[0], max(means) - means[0]
-    if total_gain <= 0:
-        return []  # it never learnt anything to lose
     found: list[Collapse] = []
     open_at: tuple[int, float, float] | None = None  # (index, mean, gain) of the collapse not yet recovered
     for i in range(1, len(means)):
@@ -94,6 +110,7 @@ class Story:
     last: Evaluation | None
     collapses: list[Collapse]
     kept_best: bool  # the model holds the best evaluation's weights (keep_best), not the last ones
+    learnt: bool = True  # its evaluations got a quarter of the way to the solved score (learnt_the_task)
 
     @property
     def keep_best_mattered(self) -> bool:
@@ -101,15 +118,16 @@ class Story:
         return self.kept_best and self.best is not None and self.last is not None and self.best.mean > self.last.mean
 
 
-def story(run_dir: Path, meta: dict) -> Story:
-    """A run folder's :class:`Story`, from its ``evals.csv`` and its model's ``meta.json``. The best
-    evaluation is the one training remembered (``best_eval``), else the highest (a tie: the later)."""
+def story(run_dir: Path, meta: dict, solved: float | None = None) -> Story:
+    """A run folder's :class:`Story`, from its ``evals.csv`` and its model's ``meta.json``; ``solved``:
+    the task's solved score, if it has one. The best evaluation is the one training remembered
+    (``best_eval``), else the highest (a tie: the later)."""
     evals = read_evals(run_dir)
     best = max(reversed(evals), key=lambda e: e.mean) if evals else None  # a tie goes to the later one
     remembered = (meta.get("best_eval") or {}).get("env_steps")
     best = next((e for e in evals if e.env_steps == remembered), best)
-    return Story(len(evals), best, evals[-1] if evals else None, collapses(evals),
-                 meta.get("weights") == "best periodic evaluation")
+    return Story(len(evals), best, evals[-1] if evals else None, collapses(evals, solved),
+                 meta.get("weights") == "best periodic evaluation", learnt_the_task(evals, solved))
 
 
 def steps_text(env_steps: int) -> str:
@@ -130,8 +148,12 @@ def story_text(s: Story, digits: int = 2) -> str:
     """One line: the collapses, then which weights the model holds."""
     if not s.evaluations:
         return "no periodic evaluations"
-    parts = [f"{len(s.collapses)} collapse{'s' if len(s.collapses) != 1 else ''}"
-             + (f" ({'; '.join(collapse_text(c, digits) for c in s.collapses)})" if s.collapses else "")]
+    if not s.learnt:
+        parts = ["no evaluation a quarter of the way to the solved score"
+                 + (f" (best {s.best.mean:.{digits}f})" if s.best is not None else "") + ": no dip counts as a collapse"]
+    else:
+        parts = [f"{len(s.collapses)} collapse{'s' if len(s.collapses) != 1 else ''}"
+                 + (f" ({'; '.join(collapse_text(c, digits) for c in s.collapses)})" if s.collapses else "")]
     if s.kept_best and s.best is not None:
         parts.append(f"model: weights of the best evaluation ({s.best.mean:.{digits}f} at {steps_text(s.best.env_steps)})"
                      + (f", the last scored {s.last.mean:.{digits}f}" if s.keep_best_mattered else ", also the last"))
@@ -151,5 +173,8 @@ def stability_summary(stories: list[Story]) -> str:
                if not mattered else
                f"in {mattered} run{'' if mattered == 1 else 's'} keep-best mattered: the model holds an earlier "
                f"evaluation's weights, which scored above the run's last evaluation")
+    unlearnt = sum(not st.learnt for st in stories if st.evaluations)
+    never = (f"; in {unlearnt} no evaluation got a quarter of the way from the run's first to the solved score, so "
+             f"none of {'its' if unlearnt == 1 else 'their'} dips counts" if unlearnt else "")
     return (f"{collapsed} of {len(stories)} runs collapsed at least once ({count} collapse{'' if count == 1 else 's'}, "
-            f"{unrecovered} not recovered); {weights}.")
+            f"{unrecovered} not recovered){never}; {weights}.")

@@ -86,7 +86,7 @@ def load_runs(sweep_dir: Path) -> list[dict]:
                      "cpu": meta.get("cpu"), "time_limit_share": ev.get("time_limit_share"),
                      "further": [(f["episodes"], f.get("success_share", f.get("mean")))
                                  for f in meta.get("further_evaluations", [])],
-                     "story": story(meta_path.parent.parent, meta),
+                     "story": story(meta_path.parent.parent, meta, _solved_score(meta)),
                      "what": f"{meta.get('experiment')} {meta.get('algo')}"})
     if not rows:
         raise UserError(f"{sweep_dir} holds no finished, evaluated run (model/meta.json with an evaluation)")
@@ -95,6 +95,17 @@ def load_runs(sweep_dir: Path) -> list[dict]:
         raise UserError(f"{sweep_dir} holds runs of {' and '.join(kinds)}: a report aggregates one experiment "
                         f"and algorithm per folder; give each its own SWEEP_DIR")
     return rows
+
+
+def _solved_score(meta: dict) -> float | None:
+    """The solved score of the task a run's meta.json names (None: it has none, or it is not known here;
+    then any gain counts as learning, :func:`rlcore.eval_history.learnt_the_task`)."""
+    from rlcore.experiment import get_experiment
+
+    try:
+        return get_experiment(meta.get("experiment", ""), meta.get("env")).solved_score
+    except (UserError, ImportError):
+        return None
 
 
 #: what ``keep`` copies of a run folder: what the report reads (meta.json, metrics.csv), the periodic

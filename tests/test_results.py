@@ -52,6 +52,17 @@ def test_the_experiment_page_tells_each_kept_sweeps_collapses_as_its_evaluations
         assert f"| {collapses_cell(r['story'].collapses)} |" in rows[str(r["seed"])]
 
 
+@pytest.mark.parametrize("name", SWEPT)
+def test_each_kept_report_tells_the_runs_stories_as_the_code_reads_them_now(name):
+    """report.md is written once by `report --keep`; when the rule that reads evals.csv changes, the kept
+    reports are written again (`main.py report results/sweeps/NAME`), and this says which are stale."""
+    from rlcore.report import stability_lines
+
+    report = (KEPT / name / "report.md").read_text()
+    for line in stability_lines(load_runs(KEPT / name)):
+        assert line in report, f"{name}/report.md is stale: run `python main.py report results/sweeps/{name}`"
+
+
 def test_a_seed_summary_gives_the_iqm_each_seed_and_the_shipped_model_beside_them():
     """The README's paragraph per kept sweep (docgen's seed-summary region), on the CartPole DQN sweep."""
     from rlcore.docgen_sweeps import seed_summary

@@ -2,7 +2,8 @@
 import pytest
 
 from rlcore.errors import UserError
-from rlcore.eval_history import Evaluation, Story, collapses, read_evals, steps_text, story, story_text
+from rlcore.eval_history import (Evaluation, Story, collapses, learnt_the_task, read_evals, stability_summary,
+                                 steps_text, story, story_text)
 
 
 def evals(*means, every=50_000):
@@ -79,3 +80,37 @@ def test_no_evals_csv_is_no_story_and_a_damaged_one_is_one_line(tmp_path):
                                          (48_000, "48k"), (1_234, "1,234")])
 def test_steps_text(steps, text):
     assert steps_text(steps) == text
+
+
+# the Minitaur sweep's seed 2, 50k ... 650k: it had not learnt to walk (the solved score is 15)
+MINITAUR_SEED_2 = (-0.34, -0.02, 0.26, 0.86, -0.07, 0.26, -0.13, -0.15, 0.04, -0.55, 0.39, 0.11, 0.26)
+
+
+def test_dips_of_a_run_that_got_nowhere_near_the_solved_score_are_not_collapses():
+    rows = evals(*MINITAUR_SEED_2)
+    assert len(collapses(rows)) == 1  # on its own scale alone, 0.86 -> -0.07 would count
+    assert collapses(rows, solved=15.0) == []  # a quarter of the way to 15 is 3.5; its best gain was 1.2
+    assert not learnt_the_task(rows, 15.0) and learnt_the_task(rows, None)
+    assert learnt_the_task(evals(*MINITAUR_SEED_0), 15.0)
+    assert len(collapses(evals(*MINITAUR_SEED_0), solved=15.0)) == 3
+
+
+def test_the_solved_score_floor_is_measured_from_the_first_evaluation():
+    # LunarLander-like: from -200, a quarter of the way to 200 is -100; 20 points of gain is not enough
+    assert not learnt_the_task(evals(-200, -180, -250), 200.0)
+    assert learnt_the_task(evals(-200, -90, -250), 200.0)
+    assert len(collapses(evals(-200, -90, -250), solved=200.0)) == 1
+    assert learnt_the_task(evals(210, 230), 200.0)  # a first evaluation already past it: any gain counts
+    assert not learnt_the_task([], 200.0)
+
+
+def test_the_story_and_the_summary_say_which_runs_had_nothing_to_lose(tmp_path):
+    (tmp_path / "evals.csv").write_text("env_steps,eval_mean,eval_std,eval_time_limit_share\n" + "".join(
+        f"{50_000 * (i + 1)},{m},0.1,0.0\n" for i, m in enumerate(MINITAUR_SEED_2)))
+    s = story(tmp_path, {"weights": "best periodic evaluation"}, solved=15.0)
+    assert not s.learnt and s.collapses == []
+    assert story_text(s).startswith("no evaluation a quarter of the way to the solved score (best 0.86)")
+    alone = story(tmp_path, {"weights": "best periodic evaluation"})  # no solved score: any gain counts
+    assert alone.learnt and len(alone.collapses) == 1
+    summary = stability_summary([s, alone])
+    assert summary.startswith("1 of 2 runs collapsed at least once (1 collapse, 1 not recovered); in 1 no evaluation")
