@@ -8,6 +8,7 @@ from pathlib import Path
 from rlcore.docgen import (GENERATED_NOTE, REPO, Model, bar_met, bar_text, eval_text, iqm_text, link,
                            model_page, num, policy_text, region_bars, region_shipped, region_sweeps,
                            score_text, sweep_score, table, EXPERIMENT_PAGES, article_of)
+from rlcore.docgen_sweeps import stop_text
 from rlcore.experiment import experiment_names, get_experiment
 from rlcore.hparams import to_dict
 
@@ -138,7 +139,7 @@ def training_section(m: Model, page: str) -> str:
             ["env steps", f"{meta['env_steps']:,}"], ["episodes", f"{meta['episodes']:,}"],
             ["wall time of training", f"{meta['wall_seconds']:,.0f} s ({meta['wall_seconds'] / 3600:.1f} h)"]]
     if meta.get("stopped_by"):
-        rows.append(["stopped by", f"`{meta['stopped_by']}`"])
+        rows.append(["stopped by", stop_text(meta, m)])
     if meta.get("weights"):
         rows.append(["weights kept", meta["weights"]])
     rows.append(["CPU", meta.get("cpu", "not recorded")])

@@ -111,6 +111,27 @@ def evaluation_cell(evaluation: dict, m) -> str:
     return f"{num(evaluation['mean'])} over {evaluation['episodes']}"
 
 
+def stop_text(meta: dict, m) -> str:
+    """What ended a run, in words (meta.json's ``stopped_by`` names the rule and its value: ``max_env_steps
+    1000000`` -> ``its budget of 1,000,000 env steps``); a rule not known here, as recorded."""
+    from rlcore.docgen import _success_word, num
+
+    recorded = meta.get("stopped_by") or ""
+    rule, _, value = recorded.partition(" ")
+    window = (meta.get("config") or {}).get("window", 100)
+    try:
+        number = float(value)
+    except ValueError:
+        return recorded or "–"
+    texts = {"max_env_steps": f"its budget of {number:,.0f} env steps",
+             "max_episodes": f"its budget of {number:,.0f} episodes",
+             "stop_eval_score": f"a periodic evaluation of {num(number)} or more",
+             "stop_score": f"a {window}-episode average of {num(number)} or more",
+             "stop_success_share": f"the {_success_word(m)} in {number:.0%} or more of the last {window} "
+                                   f"training episodes from the start"}
+    return texts.get(rule, recorded)
+
+
 def seed_runs(page: str, experiment: str) -> str:
     from rlcore.docgen import link, score_text, table
 
@@ -123,7 +144,7 @@ def seed_runs(page: str, experiment: str) -> str:
                                 for f in meta.get("further_evaluations", [])) or "–"
             rows.append([str(meta["seed"]), evaluation_cell(ev, m), further, f"{meta['env_steps']:,}",
                          _hours(meta["wall_seconds"]), f"{meta['env_steps'] / max(meta['wall_seconds'], 1e-9):,.0f}",
-                         meta.get("stopped_by") or "–"])
+                         stop_text(meta, m)])
         parts.append(f"**[{m.name}]({link(page, m.sweep.folder + '/report.md')})**, beside the shipped model's "
                      f"{score_text(m)}:\n\n"
                      + table(["seed", "unseen seeds", "further unseen seeds", "env steps", "wall", "env steps/s",

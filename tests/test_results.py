@@ -110,3 +110,20 @@ def test_a_kept_runs_model_plays_its_recorded_first_episode_again(run):
     assert np.isfinite(got)
     if exact:
         assert got == pytest.approx(first["return"], rel=1e-5)
+
+
+def test_what_ended_a_run_is_said_in_words_and_an_unknown_rule_as_recorded():
+    from types import SimpleNamespace
+
+    from rlcore.docgen_sweeps import stop_text
+
+    mario = SimpleNamespace(experiment="mario_ppo", name="1-1")
+    said = {"max_env_steps 1000000": "its budget of 1,000,000 env steps",
+            "max_episodes 600": "its budget of 600 episodes",
+            "stop_eval_score 250.0": "a periodic evaluation of 250.0 or more",
+            "stop_score 230.0": "a 50-episode average of 230.0 or more",
+            "stop_success_share 0.9": "the flag in 90% or more of the last 50 training episodes from the start",
+            "a_new_rule 3": "a_new_rule 3", "nonsense": "nonsense"}
+    for recorded, words in said.items():
+        assert stop_text({"stopped_by": recorded, "config": {"window": 50}}, mario) == words
+    assert stop_text({}, mario) == "–"
