@@ -2,6 +2,7 @@
 and whether ``--precision bfloat16`` was ever measured faster on such a CPU."""
 from __future__ import annotations
 
+import os
 import platform
 from pathlib import Path
 
@@ -53,3 +54,21 @@ def bfloat16_note(precision: str, flags: set[str] | None) -> str | None:
     return (f"note: --precision bfloat16 was measured faster only on CPUs with "
             f"{' or '.join(BFLOAT16_MATMUL)}, which this one lacks; `python benchmarks/mario.py --skip-env "
             "--skip-pool` compares both precisions here, and a resume with --precision float32 switches back")
+
+
+def bfloat16_refusal(precision: str, flags: set[str] | None, environ=os.environ) -> str | None:
+    """Why a bfloat16 network cannot run in this process, or None. TensorFlow sends bfloat16 convolutions
+    to oneDNN on any CPU with AVX-512F; a oneDNN capped below AVX-512 (``ONEDNN_MAX_CPU_ISA=AVX2``, as
+    when imitating an older CPU) has no kernel for them, and the first forward pass would fail deep in
+    TensorFlow. A CPU without AVX-512F never hits this: TensorFlow runs bfloat16 on its own kernels there."""
+    if precision != "bfloat16" or flags is None or "avx512f" not in flags:
+        return None
+    if environ.get("TF_ENABLE_ONEDNN_OPTS", "1").strip().lower() in ("0", "false"):
+        return None  # TensorFlow's own kernels, not oneDNN's
+    for name in ("ONEDNN_MAX_CPU_ISA", "DNNL_MAX_CPU_ISA"):
+        cap = environ.get(name, "").strip().upper()
+        if cap and not cap.startswith(("AVX512", "AVX10", "ALL")):
+            return (f"a bfloat16 network cannot run with {name}={cap}: on this AVX-512 CPU TensorFlow hands "
+                    f"bfloat16 convolutions to oneDNN, which has none below AVX-512; unset {name}, or set "
+                    f"TF_ENABLE_ONEDNN_OPTS=0 to use TensorFlow's own kernels")
+    return None

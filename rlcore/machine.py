@@ -40,9 +40,12 @@ DEFAULT_SETTINGS = {"onednn": True}
 
 # environment variables that change TensorFlow's or XLA's float results on one CPU when set (XLA's
 # fast-math and kernel choices, which SAC's XLA-compiled update and any jit_compile model read;
-# TensorFlow's deterministic ops): recorded by value, and only where set, so that a record made with them
-# unset, as every record before 2026-11-27 was, compares equal with a process where they are unset
-NUMERIC_VARIABLES = ("XLA_FLAGS", "TF_XLA_FLAGS", "TF_DETERMINISTIC_OPS")
+# TensorFlow's deterministic ops; oneDNN's instruction-set cap, which picks other kernels, as a CPU
+# without AVX-512 would, and its default float math mode, which may let f32 work run in bfloat16):
+# recorded by value, and only where set, so that a record made with them unset, as every record before
+# 2026-11-27 was, compares equal with a process where they are unset
+NUMERIC_VARIABLES = ("XLA_FLAGS", "TF_XLA_FLAGS", "TF_DETERMINISTIC_OPS", "ONEDNN_MAX_CPU_ISA", "DNNL_MAX_CPU_ISA",
+                     "ONEDNN_DEFAULT_FPMATH_MODE")
 
 
 def numeric_settings() -> dict:

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from rlcore.cpu import bfloat16_refusal, cpu_flags
 from rlcore.errors import UserError
 from rlcore.experiment import get_experiment
 from rlcore.sampling import sample_categorical, softmax
@@ -47,8 +48,11 @@ def load_policy(model_dir: str | Path, experiment: str | None = None, algo: str 
     spec = exp.algo(meta["algo"])
     if spec.kind not in POLICY_FILES:
         raise UserError(f"no policy loader for algorithm kind {spec.kind!r}")
+    config = config_from_meta(exp, meta)
+    if reason := bfloat16_refusal(getattr(config, "precision", "float32"), cpu_flags()):
+        raise UserError(f"{model_dir}: {reason}")
     # the registered episode limit, not the training cap: evaluations are comparable across runs
-    make_env = exp.env_factory(config_from_meta(exp, meta), max_episode_steps=None)
+    make_env = exp.env_factory(config, max_episode_steps=None)
     env = make_env()
     obs_shape, action_space = env.observation_space.shape, env.action_space
     env.close()

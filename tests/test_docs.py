@@ -120,3 +120,11 @@ def test_no_page_shows_a_doubled_percent_sign():
     hyperparameter page unexpanded: each would show ``%%`` to the reader (the report command's description did)."""
     shown = [str(path.relative_to(REPO)) for path in DOC_FILES if "%%" in path.read_text()]
     assert not shown, shown
+
+
+def test_the_reproducibility_page_names_every_setting_a_record_replays_on():
+    from rlcore import machine
+
+    page = (REPO / "docs" / "guide" / "reproducibility.md").read_text()
+    for name in ("TF_ENABLE_ONEDNN_OPTS", *machine.NUMERIC_VARIABLES):
+        assert re.search(rf"`{name}[`=]", page), name

@@ -184,3 +184,17 @@ def test_xla_flags_set_in_the_environment_are_part_of_what_a_record_replays_on(m
     assert not machine.replays_exactly(recorded)
     monkeypatch.setenv("XLA_FLAGS", "")  # set but empty: as unset
     assert machine.replays_exactly(recorded)
+
+
+def test_a_capped_onednn_instruction_set_is_part_of_what_a_record_replays_on(monkeypatch):
+    """ONEDNN_MAX_CPU_ISA=AVX2 makes oneDNN pick the kernels of a CPU without AVX-512 (and refuse the
+    bfloat16 convolutions TensorFlow still routes to it here): not the settings a record was made with."""
+    for name in ("TF_ENABLE_ONEDNN_OPTS", *machine.NUMERIC_VARIABLES):
+        monkeypatch.delenv(name, raising=False)
+    recorded = machine.this_machine()
+    for name, value in (("ONEDNN_MAX_CPU_ISA", "AVX2"), ("DNNL_MAX_CPU_ISA", "AVX2"),
+                        ("ONEDNN_DEFAULT_FPMATH_MODE", "BF16")):
+        monkeypatch.setenv(name, value)
+        assert machine.this_machine()["settings"][name] == value and not machine.replays_exactly(recorded)
+        monkeypatch.delenv(name)
+    assert machine.replays_exactly(recorded)

@@ -33,6 +33,8 @@ from keras import layers
 
 from rlcore.agents.advantages import gae
 from rlcore.configs import PPOConfig
+from rlcore.cpu import bfloat16_refusal, cpu_flags
+from rlcore.errors import UserError
 from rlcore.models import save_keras_model
 from rlcore.sampling import sample_categorical, softmax
 
@@ -80,6 +82,8 @@ def build_cnn_actor_critic(obs_shape: tuple, n_actions: int, precision: str = "f
     policy: their weights stay float32). The two heads always compute in float32, so logits, values
     and every loss built on them are float32.
     """
+    if reason := bfloat16_refusal(precision, cpu_flags()):
+        raise UserError(reason)
     body = "mixed_bfloat16" if precision == "bfloat16" else "float32"
     frames = keras.Input(obs_shape, dtype="uint8", name="frames")
     x = layers.Rescaling(1.0 / 255.0, name="to_unit", dtype=body)(frames)

@@ -90,3 +90,40 @@ def test_a_bfloat16_run_trains_and_notes_a_cpu_without_bfloat16_units(tmp_path, 
         out = capsys.readouterr().out
         note = "note: --precision bfloat16 was measured faster only on CPUs with amx_bf16 or avx512_bf16"
         assert (note in out) is noted
+
+
+def test_a_capped_onednn_refuses_bfloat16_in_one_line_only_where_it_would_fail():
+    from rlcore.cpu import bfloat16_refusal
+
+    avx512 = {"avx2", "avx512f"}
+    capped = {"ONEDNN_MAX_CPU_ISA": "avx2"}
+    assert "ONEDNN_MAX_CPU_ISA=AVX2" in bfloat16_refusal("bfloat16", avx512, capped)
+    assert "DNNL_MAX_CPU_ISA=AVX" in bfloat16_refusal("bfloat16", avx512, {"DNNL_MAX_CPU_ISA": "AVX"})
+    assert bfloat16_refusal("float32", avx512, capped) is None
+    assert bfloat16_refusal("bfloat16", {"avx2"}, capped) is None  # no AVX-512F: TensorFlow's own kernels
+    assert bfloat16_refusal("bfloat16", None, capped) is None  # flags unknown: no claim
+    assert bfloat16_refusal("bfloat16", avx512, {**capped, "TF_ENABLE_ONEDNN_OPTS": "0"}) is None
+    for cap in ("AVX512_CORE", "avx512_core_bf16", "AVX10_1_512", "ALL", ""):
+        assert bfloat16_refusal("bfloat16", avx512, {"ONEDNN_MAX_CPU_ISA": cap}) is None, cap
+
+
+def test_a_bfloat16_network_is_not_built_nor_loaded_under_a_capped_onednn(monkeypatch, capsys):
+    from pathlib import Path
+
+    import main
+    from rlcore import policies
+    from rlcore.agents import ppo
+    from rlcore.errors import UserError
+
+    monkeypatch.setenv("ONEDNN_MAX_CPU_ISA", "AVX2")
+    monkeypatch.delenv("TF_ENABLE_ONEDNN_OPTS", raising=False)
+    for module in (ppo, policies):  # as on an AVX-512 CPU, wherever these tests run
+        monkeypatch.setattr(module, "cpu_flags", lambda: {"avx2", "avx512f"})
+    with pytest.raises(UserError, match="ONEDNN_MAX_CPU_ISA=AVX2"):
+        PPOAgent(OBS, 5, BF16)
+    PPOAgent(OBS, 5, CFG)  # float32 is not affected
+    shipped = Path(__file__).resolve().parents[2] / "saved_networks" / "mario_ppo"
+    assert json.loads((shipped / "1-3" / "meta.json").read_text())["config"]["precision"] == "bfloat16"
+    assert main.main(["evaluate", "mario_ppo", "ppo", "--world", "1", "--stage", "3", "--episodes", "1"]) == 2
+    err = capsys.readouterr().err
+    assert "ONEDNN_MAX_CPU_ISA=AVX2" in err and len(err.strip().splitlines()) == 1 and "Traceback" not in err
