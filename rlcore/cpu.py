@@ -11,6 +11,8 @@ SIMD_FLAGS = ("avx2", "fma", "avx512f", "avx512_bf16", "amx_tile")  # what oneDN
 # the CPU flags bfloat16 was measured faster with (README, Speed): Intel's AMX tiles, and AMD's
 # AVX-512 bfloat16 dot products (an EPYC without AMX, 2026-11-26: update 11.6 -> 6.6 s)
 BFLOAT16_MATMUL = ("amx_bf16", "avx512_bf16")
+# the CPU flags with which TensorFlow hands bfloat16 work to oneDNN (its IsBF16SupportedByOneDNNOnThisCPU)
+ONEDNN_BFLOAT16 = ("avx512f", "avx_ne_convert")
 
 
 def first_cpu_fields(cpuinfo: str | Path = CPUINFO) -> dict[str, str]:
@@ -58,17 +60,18 @@ def bfloat16_note(precision: str, flags: set[str] | None) -> str | None:
 
 def bfloat16_refusal(precision: str, flags: set[str] | None, environ=os.environ) -> str | None:
     """Why a bfloat16 network cannot run in this process, or None. TensorFlow sends bfloat16 convolutions
-    to oneDNN on any CPU with AVX-512F; a oneDNN capped below AVX-512 (``ONEDNN_MAX_CPU_ISA=AVX2``, as
-    when imitating an older CPU) has no kernel for them, and the first forward pass would fail deep in
-    TensorFlow. A CPU without AVX-512F never hits this: TensorFlow runs bfloat16 on its own kernels there."""
-    if precision != "bfloat16" or flags is None or "avx512f" not in flags:
+    to oneDNN on any CPU with AVX-512F or AVX-NE-CONVERT; a oneDNN capped below AVX-512
+    (``ONEDNN_MAX_CPU_ISA=AVX2``, as when imitating an older CPU) has no kernel for them, and the first
+    forward pass would fail deep in TensorFlow. Other CPUs never hit this: TensorFlow runs bfloat16 on
+    its own kernels there."""
+    if precision != "bfloat16" or flags is None or not flags.intersection(ONEDNN_BFLOAT16):
         return None
     if environ.get("TF_ENABLE_ONEDNN_OPTS", "1").strip().lower() in ("0", "false"):
         return None  # TensorFlow's own kernels, not oneDNN's
     for name in ("ONEDNN_MAX_CPU_ISA", "DNNL_MAX_CPU_ISA"):
         cap = environ.get(name, "").strip().upper()
         if cap and not cap.startswith(("AVX512", "AVX10", "ALL")):
-            return (f"a bfloat16 network cannot run with {name}={cap}: on this AVX-512 CPU TensorFlow hands "
+            return (f"a bfloat16 network cannot run with {name}={cap}: on this CPU TensorFlow hands "
                     f"bfloat16 convolutions to oneDNN, which has none below AVX-512; unset {name}, or set "
                     f"TF_ENABLE_ONEDNN_OPTS=0 to use TensorFlow's own kernels")
     return None

@@ -101,6 +101,7 @@ def test_a_capped_onednn_refuses_bfloat16_in_one_line_only_where_it_would_fail()
     assert "DNNL_MAX_CPU_ISA=AVX" in bfloat16_refusal("bfloat16", avx512, {"DNNL_MAX_CPU_ISA": "AVX"})
     assert bfloat16_refusal("float32", avx512, capped) is None
     assert bfloat16_refusal("bfloat16", {"avx2"}, capped) is None  # no AVX-512F: TensorFlow's own kernels
+    assert bfloat16_refusal("bfloat16", {"avx2", "avx_ne_convert"}, capped) is not None
     assert bfloat16_refusal("bfloat16", None, capped) is None  # flags unknown: no claim
     assert bfloat16_refusal("bfloat16", avx512, {**capped, "TF_ENABLE_ONEDNN_OPTS": "0"}) is None
     for cap in ("AVX512_CORE", "avx512_core_bf16", "AVX10_1_512", "ALL", ""):
