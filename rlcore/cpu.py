@@ -68,10 +68,12 @@ def bfloat16_refusal(precision: str, flags: set[str] | None, environ=os.environ)
         return None
     if environ.get("TF_ENABLE_ONEDNN_OPTS", "1").strip().lower() in ("0", "false"):
         return None  # TensorFlow's own kernels, not oneDNN's
-    for name in ("ONEDNN_MAX_CPU_ISA", "DNNL_MAX_CPU_ISA"):
-        cap = environ.get(name, "").strip().upper()
-        if cap and not cap.startswith(("AVX512", "AVX10", "ALL")):
-            return (f"a bfloat16 network cannot run with {name}={cap}: on this CPU TensorFlow hands "
-                    f"bfloat16 convolutions to oneDNN, which has none below AVX-512; unset {name}, or set "
-                    f"TF_ENABLE_ONEDNN_OPTS=0 to use TensorFlow's own kernels")
+    # oneDNN reads its cap from ONEDNN_MAX_CPU_ISA, else from the old name; a name it does not know caps nothing
+    name = next((n for n in ("ONEDNN_MAX_CPU_ISA", "DNNL_MAX_CPU_ISA") if environ.get(n, "").strip()), None)
+    cap = environ.get(name, "").strip().upper() if name else ""
+    no_bfloat16 = {"SSE41", "AVX", "AVX2", "AVX2_VNNI"} | ({"AVX2_VNNI_2"} if "avx_ne_convert" not in flags else set())
+    if cap in no_bfloat16:
+        return (f"a bfloat16 network cannot run with {name}={cap}: on this CPU TensorFlow hands bfloat16 "
+                f"convolutions to oneDNN, which has none for that instruction set; unset {name}, or set "
+                f"TF_ENABLE_ONEDNN_OPTS=0 to use TensorFlow's own kernels")
     return None

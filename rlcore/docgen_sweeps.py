@@ -127,7 +127,7 @@ def stop_text(meta: dict, m) -> str:
              "max_episodes": f"its budget of {number:,.0f} episodes",
              "stop_eval_score": f"a periodic evaluation of {num(number)} or more",
              "stop_score": f"a {window}-episode average of {num(number)} or more",
-             "stop_success_share": f"the {_success_word(m)} in {number:.0%} or more of the last {window} "
+             "stop_success_share": f"reached the {_success_word(m)} in {number * 100:g}% or more of the last {window} "
                                    f"training episodes from the start"}
     return texts.get(rule, recorded)
 

@@ -64,26 +64,25 @@ def read_evals(run_dir: Path) -> list[Evaluation]:
     return evals
 
 
-def learnt_the_task(evals: list[Evaluation], solved: float | None, least: float = LEAST) -> bool:
-    """Whether the run's best evaluation got ``least`` of the way from its first to ``solved`` (the
-    task's solved score; None, or a first evaluation already at it: any gain counts)."""
-    if not evals:
+def far_from_solved(evals: list[Evaluation], solved: float | None, least: float = LEAST) -> bool:
+    """Whether the task has a solved score above the run's first evaluation and no evaluation got
+    ``least`` of the way there from the first. False with no solved score, a first evaluation already
+    at it, or no evaluations: then nothing is claimed."""
+    if not evals or solved is None or evals[0].mean >= solved:
         return False
-    means = [e.mean for e in evals]
-    gain = max(means) - means[0]
-    if solved is None or means[0] >= solved:
-        return gain > 0
-    return gain >= least * (solved - means[0])
+    return max(e.mean for e in evals) - evals[0].mean < least * (solved - evals[0].mean)
 
 
 def collapses(evals: list[Evaluation], solved: float | None = None, drop: float = DROP, recover: float = RECOVER,
               learnt: float = LEARNT) -> list[Collapse]:
     """The collapses of a run's evaluations, by the rule of this module's docstring; ``solved``: the
     task's solved score, if it has one."""
-    if len(evals) < 2 or not learnt_the_task(evals, solved):
-        return []  # it never learnt anything to lose
+    if len(evals) < 2 or far_from_solved(evals, solved):
+        return []  # nothing learnt to lose
     means = [e.mean for e in evals]
     base, total_gain = means[0], max(means) - means[0]
+    if total_gain <= 0:
+        return []  # it never rose above its first evaluation
     found: list[Collapse] = []
     open_at: tuple[int, float, float] | None = None  # (index, mean, gain) of the collapse not yet recovered
     for i in range(1, len(means)):
@@ -110,7 +109,7 @@ class Story:
     last: Evaluation | None
     collapses: list[Collapse]
     kept_best: bool  # the model holds the best evaluation's weights (keep_best), not the last ones
-    learnt: bool = True  # its evaluations got a quarter of the way to the solved score (learnt_the_task)
+    far_from_solved: bool = False  # no evaluation got a quarter of the way to the solved score (far_from_solved)
 
     @property
     def keep_best_mattered(self) -> bool:
@@ -127,7 +126,7 @@ def story(run_dir: Path, meta: dict, solved: float | None = None) -> Story:
     remembered = (meta.get("best_eval") or {}).get("env_steps")
     best = next((e for e in evals if e.env_steps == remembered), best)
     return Story(len(evals), best, evals[-1] if evals else None, collapses(evals, solved),
-                 meta.get("weights") == "best periodic evaluation", learnt_the_task(evals, solved))
+                 meta.get("weights") == "best periodic evaluation", far_from_solved(evals, solved))
 
 
 def steps_text(env_steps: int) -> str:
@@ -148,7 +147,7 @@ def story_text(s: Story, digits: int = 2) -> str:
     """One line: the collapses, then which weights the model holds."""
     if not s.evaluations:
         return "no periodic evaluations"
-    if not s.learnt:
+    if s.far_from_solved:
         parts = ["no evaluation a quarter of the way to the solved score"
                  + (f" (best {s.best.mean:.{digits}f})" if s.best is not None else "") + ": no dip counts as a collapse"]
     else:
@@ -173,8 +172,8 @@ def stability_summary(stories: list[Story]) -> str:
                if not mattered else
                f"in {mattered} run{'' if mattered == 1 else 's'} keep-best mattered: the model holds an earlier "
                f"evaluation's weights, which scored above the run's last evaluation")
-    unlearnt = sum(not st.learnt for st in stories if st.evaluations)
-    never = (f"; in {unlearnt} no evaluation got a quarter of the way from the run's first to the solved score, so "
-             f"none of {'its' if unlearnt == 1 else 'their'} dips counts" if unlearnt else "")
+    far = sum(st.far_from_solved for st in stories if st.evaluations)
+    never = (f"; in {far} run{'' if far == 1 else 's'} no evaluation got a quarter of the way from the first to "
+             f"the solved score, so none of {'its' if far == 1 else 'their'} dips counts" if far else "")
     return (f"{collapsed} of {len(stories)} runs collapsed at least once ({count} collapse{'' if count == 1 else 's'}, "
             f"{unrecovered} not recovered){never}; {weights}.")

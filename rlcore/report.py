@@ -98,13 +98,20 @@ def load_runs(sweep_dir: Path) -> list[dict]:
 
 
 def _solved_score(meta: dict) -> float | None:
-    """The solved score of the task a run's meta.json names (None: it has none, or it is not known here;
-    then any gain counts as learning, :func:`rlcore.eval_history.learnt_the_task`)."""
-    from rlcore.experiment import get_experiment
+    """The solved score of the task a run's meta.json names: a Gymnasium id's recorded
+    ``reward_threshold``, else the registry's. None where it has none or it cannot be known here (then
+    nothing is claimed, :func:`rlcore.eval_history.far_from_solved`): a report never needs the env itself."""
+    from rlcore.experiment import EXPERIMENT_MODULES, get_experiment
 
+    env = meta.get("env")
+    if isinstance(env, dict) and "reward_threshold" in env:
+        threshold = env["reward_threshold"]
+        return None if threshold is None else float(threshold)
+    if meta.get("experiment") not in EXPERIMENT_MODULES:
+        return None  # a Gymnasium id without its record: building its env only to learn this is not worth it
     try:
-        return get_experiment(meta.get("experiment", ""), meta.get("env")).solved_score
-    except (UserError, ImportError):
+        return get_experiment(meta["experiment"]).solved_score
+    except Exception:  # the experiment's extra is missing, or its module fails to import: no claim
         return None
 
 

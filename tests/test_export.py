@@ -15,6 +15,7 @@ from rlcore import export
 from rlcore.errors import UserError
 from rlcore.export_parity import ParityError, collect_observations
 from rlcore.policies import load_policy
+from tests.cpu_support import needs_bfloat16
 
 SHIPPED = Path(__file__).resolve().parents[1] / "saved_networks"
 MODELS = {"dqn": "lunar_lander/dqn", "a2c": "cartpole/a2c", "ppo": "mario_ppo/1-1", "sac": "minitaur/sac"}
@@ -65,6 +66,7 @@ def test_sac_export_carries_its_standardize_layer():
     np.testing.assert_allclose(acting(obs).numpy(), policy(obs), atol=1e-6)  # tanh(mean), as evaluated
 
 
+@needs_bfloat16
 def test_a_bfloat16_network_is_exported_in_float32():
     from rlcore.agents.ppo import build_actor_critic
 

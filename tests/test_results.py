@@ -122,7 +122,8 @@ def test_what_ended_a_run_is_said_in_words_and_an_unknown_rule_as_recorded():
             "max_episodes 600": "its budget of 600 episodes",
             "stop_eval_score 250.0": "a periodic evaluation of 250.0 or more",
             "stop_score 230.0": "a 50-episode average of 230.0 or more",
-            "stop_success_share 0.9": "the flag in 90% or more of the last 50 training episodes from the start",
+            "stop_success_share 0.9": "reached the flag in 90% or more of the last 50 training episodes from the start",
+            "stop_success_share 0.825": "reached the flag in 82.5% or more of the last 50 training episodes from the start",
             "a_new_rule 3": "a_new_rule 3", "nonsense": "nonsense"}
     for recorded, words in said.items():
         assert stop_text({"stopped_by": recorded, "config": {"window": 50}}, mario) == words

@@ -2,7 +2,7 @@
 import pytest
 
 from rlcore.errors import UserError
-from rlcore.eval_history import (Evaluation, Story, collapses, learnt_the_task, read_evals, stability_summary,
+from rlcore.eval_history import (Evaluation, Story, collapses, far_from_solved, read_evals, stability_summary,
                                  steps_text, story, story_text)
 
 
@@ -90,27 +90,47 @@ def test_dips_of_a_run_that_got_nowhere_near_the_solved_score_are_not_collapses(
     rows = evals(*MINITAUR_SEED_2)
     assert len(collapses(rows)) == 1  # on its own scale alone, 0.86 -> -0.07 would count
     assert collapses(rows, solved=15.0) == []  # a quarter of the way to 15 is 3.5; its best gain was 1.2
-    assert not learnt_the_task(rows, 15.0) and learnt_the_task(rows, None)
-    assert learnt_the_task(evals(*MINITAUR_SEED_0), 15.0)
+    assert far_from_solved(rows, 15.0) and not far_from_solved(rows, None)
+    assert not far_from_solved(evals(*MINITAUR_SEED_0), 15.0)
     assert len(collapses(evals(*MINITAUR_SEED_0), solved=15.0)) == 3
 
 
 def test_the_solved_score_floor_is_measured_from_the_first_evaluation():
     # LunarLander-like: from -200, a quarter of the way to 200 is -100; 20 points of gain is not enough
-    assert not learnt_the_task(evals(-200, -180, -250), 200.0)
-    assert learnt_the_task(evals(-200, -90, -250), 200.0)
+    assert far_from_solved(evals(-200, -180, -250), 200.0)
+    assert not far_from_solved(evals(-200, -90, -250), 200.0)
     assert len(collapses(evals(-200, -90, -250), solved=200.0)) == 1
-    assert learnt_the_task(evals(210, 230), 200.0)  # a first evaluation already past it: any gain counts
-    assert not learnt_the_task([], 200.0)
+    # nothing claimed: a first evaluation already at the solved score, no solved score, no evaluations
+    assert not far_from_solved(evals(500, 500, 500), 500.0) and not far_from_solved(evals(0, 0), None)
+    assert not far_from_solved([], 200.0)
+
+
+def test_a_run_that_never_rose_is_told_as_no_collapses_not_as_far_from_solved(tmp_path):
+    (tmp_path / "evals.csv").write_text("env_steps,eval_mean,eval_std,eval_time_limit_share\n"
+                                        "1000,500,0,1\n2000,500,0,1\n3000,500,0,1\n")
+    for solved in (500.0, None):
+        s = story(tmp_path, {"weights": "last"}, solved=solved)
+        assert story_text(s) == "0 collapses; model: the last weights"
+        assert stability_summary([s]).startswith("0 of 1 runs collapsed at least once (0 collapses, 0 not recovered); ")
 
 
 def test_the_story_and_the_summary_say_which_runs_had_nothing_to_lose(tmp_path):
     (tmp_path / "evals.csv").write_text("env_steps,eval_mean,eval_std,eval_time_limit_share\n" + "".join(
         f"{50_000 * (i + 1)},{m},0.1,0.0\n" for i, m in enumerate(MINITAUR_SEED_2)))
     s = story(tmp_path, {"weights": "best periodic evaluation"}, solved=15.0)
-    assert not s.learnt and s.collapses == []
+    assert s.far_from_solved and s.collapses == []
     assert story_text(s).startswith("no evaluation a quarter of the way to the solved score (best 0.86)")
     alone = story(tmp_path, {"weights": "best periodic evaluation"})  # no solved score: any gain counts
-    assert alone.learnt and len(alone.collapses) == 1
+    assert not alone.far_from_solved and len(alone.collapses) == 1
     summary = stability_summary([s, alone])
-    assert summary.startswith("1 of 2 runs collapsed at least once (1 collapse, 1 not recovered); in 1 no evaluation")
+    assert summary.startswith("1 of 2 runs collapsed at least once (1 collapse, 1 not recovered); in 1 run no evaluation")
+
+
+def test_a_report_knows_the_solved_score_from_the_record_or_the_registry_and_else_claims_nothing():
+    from rlcore.report import _solved_score
+
+    assert _solved_score({"experiment": "minitaur"}) == 15.0
+    assert _solved_score({"experiment": "Acrobot-v1", "env": {"reward_threshold": -100}}) == -100.0
+    assert _solved_score({"experiment": "my_envs:Maze-v0", "env": {"reward_threshold": None}}) is None
+    assert _solved_score({"experiment": "my_envs:Maze-v0"}) is None  # no record: its env is not built for this
+    assert _solved_score({"experiment": "mario_ppo"}) is None  # success is the flag
