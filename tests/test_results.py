@@ -128,3 +128,17 @@ def test_what_ended_a_run_is_said_in_words_and_an_unknown_rule_as_recorded():
     for recorded, words in said.items():
         assert stop_text({"stopped_by": recorded, "config": {"window": 50}}, mario) == words
     assert stop_text({}, mario) == "–"
+
+
+def test_a_seeds_score_gives_its_full_length_share_where_the_bar_asks_for_one():
+    from types import SimpleNamespace
+
+    from rlcore.docgen_sweeps import evaluation_cell
+    from rlcore.experiment import get_experiment
+
+    minitaur = SimpleNamespace(experiment="minitaur", name="sac", bar=get_experiment("minitaur").bar("sac"))
+    lander = SimpleNamespace(experiment="lunar_lander", name="dqn", bar=get_experiment("lunar_lander").bar("dqn"))
+    walked = {"mean": 18.56, "episodes": 30, "time_limit_share": 0.9333}
+    assert evaluation_cell(walked, minitaur) == "18.6 over 30, 93% full length"
+    assert evaluation_cell(walked, lander) == "18.6 over 30"  # its bar asks for no such share
+    assert evaluation_cell({"mean": 18.56, "episodes": 30}, minitaur) == "18.6 over 30"  # not recorded
