@@ -48,7 +48,7 @@ def next_command(repo: Path = REPO) -> list[str] | None:
     minitaur = repo / MINITAUR
     if (minitaur / "sweep.json").is_file():
         trials = [trial_name(trial) for trial in Sweep.load(minitaur).trials()]
-        if not all((minitaur / name / "model" / "meta.json").is_file() for name in trials):
+        if not all(_evaluated(minitaur / name) for name in trials):  # the sweep's resume evaluates a trained one
             return ["sweep", "minitaur", "sac", "--dir", "long_runs/sweeps", "--name", "minitaur__sac", "--resume",
                     "--num-cpus", "1"]
     if (repo / MARIO_KEPT).exists():
@@ -57,6 +57,8 @@ def next_command(repo: Path = REPO) -> list[str] | None:
         run = repo / mario_dir(seed)
         meta = run / "model" / "meta.json"
         if meta.is_file():
+            if not _evaluated(run):  # trained, but the process ended before its 10-episode evaluation
+                return ["evaluate", "mario_ppo", "ppo", "--model", mario_dir(seed), "--record"]
             if not json.loads(meta.read_text()).get("further_evaluations"):
                 return ["evaluate", "mario_ppo", "ppo", "--model", mario_dir(seed), "--episodes", "30",
                         "--record-further"]
@@ -65,6 +67,12 @@ def next_command(repo: Path = REPO) -> list[str] | None:
             return ["train", "mario_ppo", "ppo", "--resume", mario_dir(seed), *QUIET]
         return ["train", "mario_ppo", "ppo", *MARIO_RECIPE, "--seed", str(seed), "--run-dir", mario_dir(seed), *QUIET]
     return None
+
+
+def _evaluated(run: Path) -> bool:
+    """The run has trained and its evaluation on unseen seeds is in its model's meta.json."""
+    meta = run / "model" / "meta.json"
+    return meta.is_file() and bool(json.loads(meta.read_text()).get("evaluation"))
 
 
 def main(argv: list[str] | None = None) -> int:

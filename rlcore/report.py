@@ -73,13 +73,14 @@ def load_runs(sweep_dir: Path) -> list[dict]:
     sweep_dir = Path(sweep_dir)
     if not sweep_dir.is_dir():
         raise UserError(f"no sweep folder {sweep_dir}")
-    rows = []
+    rows, unevaluated = [], []
     for meta_path in sorted(sweep_dir.glob("*/model/meta.json")):
         meta = json.loads(meta_path.read_text())
         ev = meta.get("evaluation") or {}
         score = ev.get("success_share", ev.get("mean"))
         if score is None:
-            continue  # trained but not evaluated: nothing to aggregate
+            unevaluated.append(meta_path.parent.parent.name)  # trained but not evaluated: no score
+            continue
         rows.append({"trial": meta_path.parent.parent.name, "seed": meta["seed"], "score": float(score),
                      "eval_episodes": ev.get("episodes"), "env_steps": meta["env_steps"],
                      "wall_seconds": meta["wall_seconds"], "run_dir": meta_path.parent.parent,
@@ -90,6 +91,10 @@ def load_runs(sweep_dir: Path) -> list[dict]:
                      "what": f"{meta.get('experiment')} {meta.get('algo')}"})
     if not rows:
         raise UserError(f"{sweep_dir} holds no finished, evaluated run (model/meta.json with an evaluation)")
+    if unevaluated:  # leaving a trained seed out would report the others as if they were all
+        raise UserError(f"{sweep_dir}: {', '.join(unevaluated)} trained but has no evaluation on unseen seeds; "
+                        f"evaluate it first (a sweep's --resume does, or `python main.py evaluate ... --model "
+                        f"RUN_DIR --record`)")
     kinds = sorted({row["what"] for row in rows})
     if len(kinds) > 1:  # one aggregate over unlike scores would mean nothing
         raise UserError(f"{sweep_dir} holds runs of {' and '.join(kinds)}: a report aggregates one experiment "

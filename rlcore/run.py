@@ -68,8 +68,23 @@ def run_training(spec: RunSpec, on_progress: Callable[[dict, str], None] | None 
     if on_progress is not None:
         spec.on_progress = on_progress
     trainer = importlib.import_module(f"rlcore.trainers.{spec.kind}")
+    _import_the_end_of_a_run()
     with hold_run_folder(spec.run_dir):  # one writer per run folder (a second one is refused here)
         return trainer.train(spec)
+
+
+#: what the end of a run imports inside its functions: its model, the final evaluation, meta.json
+END_OF_RUN_MODULES = ("rlcore.atomic", "rlcore.evaluation", "rlcore.machine", "rlcore.models", "rlcore.plotting",
+                      "rlcore.policies", "rlcore.shipping")
+
+
+def _import_the_end_of_a_run() -> None:
+    """Import now the modules the end of a run imports (its model, the final evaluation, meta.json). A
+    run takes hours, and a package edited meanwhile must not meet this process's older modules there:
+    a module loaded only at the end, asking a module loaded at the start for a name the edit added,
+    fails (a Minitaur trial, 2026-11-27: trained 1M steps, then "cannot import name" before its evaluation)."""
+    for name in END_OF_RUN_MODULES:
+        importlib.import_module(name)
 
 
 def budget_overrides(episodes: int | None, steps: int | None, given: dict | None = None) -> dict:

@@ -152,8 +152,8 @@ def run_trial(trial: dict, sweep: dict, modules: dict, report) -> dict:
     sweep = Sweep(**sweep)
     run_dir = Path(sweep.folder) / trial_name(trial)
     meta_path = run_dir / "model" / "meta.json"
-    if meta_path.is_file():  # finished before: not run again
-        return final_metrics(json.loads(meta_path.read_text()), skipped=True)
+    if meta_path.is_file():  # trained before: not trained again
+        return _finish_evaluation(trial, sweep, json.loads(meta_path.read_text()))
     if (Path(sweep.folder) / STOP_FILE).exists():  # the sweep is stopping: a trial not begun stays so
         return {"interrupted": 1, "not_started": 1}
     from rlcore.run_lock import hold_run_folder
@@ -171,6 +171,21 @@ def run_trial(trial: dict, sweep: dict, modules: dict, report) -> dict:
     except BaseException as exc:  # the worker's own end (Ray restarts it from the checkpoint)
         log_trial(sweep, trial, f"stopped: {type(exc).__name__}")
         raise
+
+
+def _finish_evaluation(trial: dict, sweep: Sweep, meta: dict) -> dict:
+    """The final metrics of a trial that has trained; one whose evaluation on unseen seeds never ran
+    (the process ended between the two) is evaluated now, so no trained seed drops out of the report."""
+    from rlcore import shipping
+    from rlcore.experiment import get_experiment
+
+    episodes = shipping.eval_episodes(get_experiment(sweep.experiment), sweep.final_eval_episodes)
+    if episodes == 0 or meta.get("evaluation"):
+        return final_metrics(meta, skipped=True)
+    log_trial(sweep, trial, "trained but not evaluated: evaluating")
+    meta = shipping.evaluate_into_meta(Path(sweep.folder) / trial_name(trial) / "model", episodes)
+    log_trial(sweep, trial, "evaluated")
+    return final_metrics(meta)
 
 
 def log_trial(sweep: Sweep, trial: dict, event: str) -> None:

@@ -30,10 +30,12 @@ def test_the_queue_runs_the_minitaur_sweep_then_each_mario_seed_then_its_further
     sweep = tmp_path / queue.MINITAUR
     sweep.mkdir(parents=True)
     Sweep("minitaur", "sac", "minitaur__sac", str(sweep), [0, 1]).save()
-    _finish(sweep / "seed=0")
+    _finish(sweep / "seed=0", evaluation={"mean": 18.6})
     steps = [queue.next_command(tmp_path)]
     assert steps[-1][:3] == ["sweep", "minitaur", "sac"] and "--resume" in steps[-1]
-    _finish(sweep / "seed=1")  # every trial finished: on to Mario, whether or not the sweep is kept yet
+    _finish(sweep / "seed=1")  # trained, not evaluated: the sweep's resume evaluates it
+    assert queue.next_command(tmp_path) == steps[-1]
+    _finish(sweep / "seed=1", evaluation={"mean": 20.8})  # every trial evaluated: on to Mario, kept or not
     steps.append(queue.next_command(tmp_path))
     assert steps[-1][:3] == ["train", "mario_ppo", "ppo"] and steps[-1][steps[-1].index("--seed") + 1] == "0"
     seed0 = tmp_path / queue.mario_dir(0)
@@ -42,6 +44,9 @@ def test_the_queue_runs_the_minitaur_sweep_then_each_mario_seed_then_its_further
     steps.append(queue.next_command(tmp_path))
     assert steps[-1] == ["train", "mario_ppo", "ppo", "--resume", queue.mario_dir(0), "--wandb", "offline",
                          "--no-progress"]
+    _finish(seed0)  # trained, but ended before its 10-episode evaluation: that evaluation, recorded
+    steps.append(queue.next_command(tmp_path))
+    assert steps[-1] == ["evaluate", "mario_ppo", "ppo", "--model", queue.mario_dir(0), "--record"]
     _finish(seed0, evaluation={"episodes": 10})
     steps.append(queue.next_command(tmp_path))
     assert steps[-1][:2] == ["evaluate", "mario_ppo"] and "--record-further" in steps[-1]
@@ -49,7 +54,7 @@ def test_the_queue_runs_the_minitaur_sweep_then_each_mario_seed_then_its_further
     steps.append(queue.next_command(tmp_path))
     assert steps[-1][steps[-1].index("--seed") + 1] == "1"
     for seed in queue.MARIO_SEEDS:
-        _finish(tmp_path / queue.mario_dir(seed), further_evaluations=[{"episodes": 30}])
+        _finish(tmp_path / queue.mario_dir(seed), evaluation={"episodes": 10}, further_evaluations=[{"episodes": 30}])
     assert queue.next_command(tmp_path) is None
     (tmp_path / queue.MARIO_KEPT).mkdir(parents=True)
     assert queue.next_command(tmp_path) is None
@@ -71,10 +76,10 @@ def test_a_sweep_with_a_grid_is_waited_for_by_its_trials_names(tmp_path):
     sweep = tmp_path / queue.MINITAUR
     sweep.mkdir(parents=True)
     Sweep("minitaur", "sac", "minitaur__sac", str(sweep), [0], {"lr": [1e-3, 3e-4]}).save()
-    _finish(sweep / "seed=0")  # not a trial of this sweep: its trials are lr=...__seed=0
+    _finish(sweep / "seed=0", evaluation={"mean": 1.0})  # not a trial of this sweep: its trials are lr=...__seed=0
     assert queue.next_command(tmp_path)[0] == "sweep"
     for name in ("lr=0.001__seed=0", "lr=0.0003__seed=0"):
-        _finish(sweep / name)
+        _finish(sweep / name, evaluation={"mean": 1.0})
     assert queue.next_command(tmp_path)[0] == "train"
 
 

@@ -385,3 +385,59 @@ def test_a_run_resumed_before_resumes_recorded_their_changes_is_not_kept():
     with pytest.raises(UserError, match="does not say what its command 2 \\(a resume\\) changed"):
         check_one_recipe_throughout(Path("R"), old)
     check_one_recipe_throughout(Path("R"), {"commands": ["python main.py train mario_ppo ppo --seed 0"]})  # never resumed
+
+
+def test_a_trial_trained_but_not_evaluated_is_evaluated_on_resume_and_never_left_out_of_a_report(tmp_path, capsys):
+    """A process that ends between the training and the evaluation on unseen seeds (as a trial did on
+    2026-11-27) leaves model/meta.json without an evaluation: the sweep's resume evaluates it rather than
+    skip it as finished, the status says so, and a report refuses the folder until then rather than
+    aggregate the other seeds as if they were all."""
+    import dataclasses
+
+    from rlcore.errors import UserError
+    from rlcore.sweep import run_trial
+    sweep = _sweep(tmp_path, "late", seeds=(0,))
+    Path(sweep.folder).mkdir()
+    sweep.save()
+    args = ({"seed": 0}, dataclasses.asdict(sweep), {"toy": "tests.toy"}, lambda metrics: None)
+    first = run_trial(*args)
+    meta_path = tmp_path / "late" / "seed=0" / "model" / "meta.json"
+    meta = json.loads(meta_path.read_text())
+    evaluation = meta.pop("evaluation")
+    meta_path.write_text(json.dumps(meta))
+    code, out, err = run(capsys, "status", str(tmp_path / "late"))
+    assert "seed=0: finished at" in out and "not evaluated yet (the sweep's --resume evaluates it)" in out
+    other = tmp_path / "late" / "seed=1" / "model"  # a second seed, evaluated
+    other.mkdir(parents=True)
+    (other / "meta.json").write_text(json.dumps({**meta, "seed": 1, "evaluation": evaluation}))
+    with pytest.raises(UserError, match="seed=0 trained but has no evaluation on unseen seeds"):
+        load_runs(tmp_path / "late")
+    again = run_trial(*args)
+    assert again["skipped"] == 0 and again["final_score"] == first["final_score"]  # the same seeds, the same model
+    assert json.loads(meta_path.read_text())["evaluation"]["per_episode"] == evaluation["per_episode"]
+    assert "seed=0 pid" in (log := (tmp_path / "late" / "trials.log").read_text())
+    assert "trained but not evaluated: evaluating" in log and log.rstrip().endswith("evaluated")
+    assert run_trial(*args)["skipped"] == 1  # evaluated now: finished
+    assert [r["seed"] for r in load_runs(tmp_path / "late")] == [0, 1]
+
+
+def test_the_end_of_a_run_is_imported_at_its_start():
+    """Every rlcore module that the end-of-run modules import inside their functions is loaded by
+    `_import_the_end_of_a_run`, so an edit made while a run trains cannot meet older modules there."""
+    script = """
+import ast, importlib, sys
+from pathlib import Path
+import rlcore.run as run
+run._import_the_end_of_a_run()
+missing = set()
+for name in run.END_OF_RUN_MODULES:
+    tree = ast.parse(Path(sys.modules[name].__file__).read_text())
+    for fn in (n for n in ast.walk(tree) if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef))):
+        for node in ast.walk(fn):
+            if isinstance(node, ast.ImportFrom) and (node.module or "").startswith("rlcore"):
+                missing |= {node.module} - set(sys.modules)
+print(sorted(missing))
+"""
+    done = subprocess.run([sys.executable, "-c", script], cwd=ROOT, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.strip().splitlines()[-1] == "[]"
