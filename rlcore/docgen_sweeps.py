@@ -103,7 +103,7 @@ def _hours(seconds: float) -> str:
 
 def evaluation_cell(evaluation: dict, m) -> str:
     """``flag in 9 of 10`` (Mario), ``18.6 over 30``, and where the bar asks for episodes that last to the
-    time limit, ``18.6 over 30, 93% full length``: one recorded evaluation, as the card writes it."""
+    time limit, ``18.6 over 30 (93% full length)``: one recorded evaluation, as the card writes it."""
     from rlcore.docgen import _success_word, num
 
     if "success_share" in evaluation:
@@ -112,7 +112,7 @@ def evaluation_cell(evaluation: dict, m) -> str:
     text = f"{num(evaluation['mean'])} over {evaluation['episodes']}"
     share = evaluation.get("time_limit_share")
     if share is not None and m.bar is not None and m.bar.full_length_share is not None:
-        text += f", {share:.0%} full length"
+        text += f" ({share:.0%} full length)"
     return text
 
 

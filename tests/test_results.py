@@ -139,6 +139,6 @@ def test_a_seeds_score_gives_its_full_length_share_where_the_bar_asks_for_one():
     minitaur = SimpleNamespace(experiment="minitaur", name="sac", bar=get_experiment("minitaur").bar("sac"))
     lander = SimpleNamespace(experiment="lunar_lander", name="dqn", bar=get_experiment("lunar_lander").bar("dqn"))
     walked = {"mean": 18.56, "episodes": 30, "time_limit_share": 0.9333}
-    assert evaluation_cell(walked, minitaur) == "18.6 over 30, 93% full length"
+    assert evaluation_cell(walked, minitaur) == "18.6 over 30 (93% full length)"
     assert evaluation_cell(walked, lander) == "18.6 over 30"  # its bar asks for no such share
     assert evaluation_cell({"mean": 18.56, "episodes": 30}, minitaur) == "18.6 over 30"  # not recorded
