@@ -47,8 +47,9 @@ def next_command(repo: Path = REPO) -> list[str] | None:
 
     minitaur = repo / MINITAUR
     if (minitaur / "sweep.json").is_file():
-        trials = [trial_name(trial) for trial in Sweep.load(minitaur).trials()]
-        if not all(_evaluated(minitaur / name) for name in trials):  # the sweep's resume evaluates a trained one
+        sweep = Sweep.load(minitaur)
+        done = _evaluated if sweep.final_eval_episodes != 0 else (lambda run: (run / "model" / "meta.json").is_file())
+        if not all(done(minitaur / trial_name(trial)) for trial in sweep.trials()):  # its resume evaluates a trained one
             return ["sweep", "minitaur", "sac", "--dir", "long_runs/sweeps", "--name", "minitaur__sac", "--resume",
                     "--num-cpus", "1"]
     if (repo / MARIO_KEPT).exists():

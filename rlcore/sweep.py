@@ -9,8 +9,9 @@ A trial calls :func:`rlcore.run.run_training`, the function ``main.py train`` ca
 every logged row to Tune as it comes. Fault tolerance lives in the run folder, not in Tune: a trial
 that starts where a checkpoint exists resumes it (so a trial whose worker was killed and that Tune
 restarts continues its counters; one killed before its first checkpoint starts over, its tables
-cleared), and a trial whose ``model/meta.json`` exists is finished and is
-not run again (``--resume``). A trial that fails with a user error (a bad value, a diverged loss, a
+cleared), and a trial whose ``model/meta.json`` exists has trained and is not trained again
+(``--resume``): it is finished once that file holds its evaluation on unseen seeds, and evaluated first
+where the process ended before it. A trial that fails with a user error (a bad value, a diverged loss, a
 run folder another process writes) is reported once, not retried: a retry would fail the same way. Ctrl-C or SIGTERM writes ``sweeps/<name>/STOP``: every running trial
 stops at its next safe point with a checkpoint, and the sweep ends (then Ray is shut down; a driver
 killed outright would leave Ray's workers running).
@@ -152,17 +153,19 @@ def run_trial(trial: dict, sweep: dict, modules: dict, report) -> dict:
     sweep = Sweep(**sweep)
     run_dir = Path(sweep.folder) / trial_name(trial)
     meta_path = run_dir / "model" / "meta.json"
-    if meta_path.is_file():  # trained before: not trained again
-        return _finish_evaluation(trial, sweep, json.loads(meta_path.read_text()))
+    meta = json.loads(meta_path.read_text()) if meta_path.is_file() else None
+    if meta is not None and not _wants_evaluation(sweep, meta):  # finished before: not run again
+        return final_metrics(meta, skipped=True)
     if (Path(sweep.folder) / STOP_FILE).exists():  # the sweep is stopping: a trial not begun stays so
         return {"interrupted": 1, "not_started": 1}
     from rlcore.run_lock import hold_run_folder
 
-    log_trial(sweep, trial, "started")
+    log_trial(sweep, trial, "started" if meta is None else "trained but not evaluated: evaluating")
     try:
         with hold_run_folder(run_dir):  # one writer: a trial restarted while its old worker lives is refused
             (run_dir / "worker.pid").write_text(f"{os.getpid()}\n")
-            result = _train_trial(trial, sweep, run_dir, report)
+            result = (_train_trial(trial, sweep, run_dir, report) if meta is None
+                      else final_metrics(_evaluate_trial(sweep, run_dir)))
         log_trial(sweep, trial, "stopped at a checkpoint" if result.get("interrupted") else "finished")
         return result
     except UserError as exc:  # a bad value, a diverged loss, a busy folder: a retry would fail the same way
@@ -173,19 +176,20 @@ def run_trial(trial: dict, sweep: dict, modules: dict, report) -> dict:
         raise
 
 
-def _finish_evaluation(trial: dict, sweep: Sweep, meta: dict) -> dict:
-    """The final metrics of a trial that has trained; one whose evaluation on unseen seeds never ran
-    (the process ended between the two) is evaluated now, so no trained seed drops out of the report."""
+def _wants_evaluation(sweep: Sweep, meta: dict) -> bool:
+    """A trained trial whose evaluation on unseen seeds never ran (the process ended between the two)
+    and whose sweep asks for one: it is evaluated before it counts as finished, so no trained seed drops
+    out of the report."""
+    return not meta.get("evaluation") and sweep.final_eval_episodes != 0
+
+
+def _evaluate_trial(sweep: Sweep, run_dir: Path) -> dict:
+    """Evaluate a trained trial's model on unseen seeds into its meta.json; return the meta."""
     from rlcore import shipping
     from rlcore.experiment import get_experiment
 
     episodes = shipping.eval_episodes(get_experiment(sweep.experiment), sweep.final_eval_episodes)
-    if episodes == 0 or meta.get("evaluation"):
-        return final_metrics(meta, skipped=True)
-    log_trial(sweep, trial, "trained but not evaluated: evaluating")
-    meta = shipping.evaluate_into_meta(Path(sweep.folder) / trial_name(trial) / "model", episodes)
-    log_trial(sweep, trial, "evaluated")
-    return final_metrics(meta)
+    return shipping.evaluate_into_meta(run_dir / "model", episodes)
 
 
 def log_trial(sweep: Sweep, trial: dict, event: str) -> None:

@@ -40,7 +40,8 @@ def sweep_status(folder: str | Path) -> list[str]:
             lines.append(f"  {name}: finished at {final['env_steps']:,} env steps"
                          + (f", final score {final['final_score']:.2f} on unseen seeds"
                             if not math.isnan(final["final_score"]) else  # NaN: not evaluated
-                            "; not evaluated yet (the sweep's --resume evaluates it)"))
+                            "; not evaluated on unseen seeds" + ("" if sweep.final_eval_episodes == 0 else
+                                                                 " yet (the sweep's --resume evaluates it)")))
             continue
         try:
             measured = pace(trial / "metrics.csv", record)

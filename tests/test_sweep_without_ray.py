@@ -406,7 +406,7 @@ def test_a_trial_trained_but_not_evaluated_is_evaluated_on_resume_and_never_left
     evaluation = meta.pop("evaluation")
     meta_path.write_text(json.dumps(meta))
     code, out, err = run(capsys, "status", str(tmp_path / "late"))
-    assert "seed=0: finished at" in out and "not evaluated yet (the sweep's --resume evaluates it)" in out
+    assert "seed=0: finished at" in out and "not evaluated on unseen seeds yet (the sweep's --resume evaluates it)" in out
     other = tmp_path / "late" / "seed=1" / "model"  # a second seed, evaluated
     other.mkdir(parents=True)
     (other / "meta.json").write_text(json.dumps({**meta, "seed": 1, "evaluation": evaluation}))
@@ -416,9 +416,15 @@ def test_a_trial_trained_but_not_evaluated_is_evaluated_on_resume_and_never_left
     assert again["skipped"] == 0 and again["final_score"] == first["final_score"]  # the same seeds, the same model
     assert json.loads(meta_path.read_text())["evaluation"]["per_episode"] == evaluation["per_episode"]
     assert "seed=0 pid" in (log := (tmp_path / "late" / "trials.log").read_text())
-    assert "trained but not evaluated: evaluating" in log and log.rstrip().endswith("evaluated")
+    assert "trained but not evaluated: evaluating" in log and log.rstrip().endswith("finished")
     assert run_trial(*args)["skipped"] == 1  # evaluated now: finished
     assert [r["seed"] for r in load_runs(tmp_path / "late")] == [0, 1]
+    meta_path.write_text(json.dumps(meta))  # without its evaluation again
+    (tmp_path / "late" / "STOP").touch()  # a stopping sweep begins no evaluation either
+    assert run_trial(*args) == {"interrupted": 1, "not_started": 1}
+    (tmp_path / "late" / "STOP").unlink()
+    no_evaluations = dataclasses.asdict(dataclasses.replace(sweep, final_eval_episodes=0))
+    assert run_trial({"seed": 0}, no_evaluations, {"toy": "tests.toy"}, lambda metrics: None)["skipped"] == 1
 
 
 def test_the_end_of_a_run_is_imported_at_its_start():
@@ -434,10 +440,30 @@ for name in run.END_OF_RUN_MODULES:
     tree = ast.parse(Path(sys.modules[name].__file__).read_text())
     for fn in (n for n in ast.walk(tree) if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef))):
         for node in ast.walk(fn):
-            if isinstance(node, ast.ImportFrom) and (node.module or "").startswith("rlcore"):
+            if isinstance(node, ast.ImportFrom) and node.module == "rlcore":  # from rlcore import x
+                missing |= {f"rlcore.{a.name}" for a in node.names} - set(sys.modules)
+            elif isinstance(node, ast.ImportFrom) and (node.module or "").startswith("rlcore."):
                 missing |= {node.module} - set(sys.modules)
+            elif isinstance(node, ast.Import):
+                missing |= {a.name for a in node.names if a.name.startswith("rlcore.")} - set(sys.modules)
 print(sorted(missing))
 """
-    done = subprocess.run([sys.executable, "-c", script], cwd=ROOT, capture_output=True, text=True, timeout=120)
+    done = subprocess.run([sys.executable, "-c", script], cwd=ROOT, capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr[-2000:]
     assert done.stdout.strip().splitlines()[-1] == "[]"
+
+
+def test_run_training_imports_the_end_of_the_run_before_it_trains(monkeypatch, tmp_path):
+    from rlcore import run
+
+    class Imported(Exception):
+        pass
+
+    def imported():
+        raise Imported
+
+    monkeypatch.setattr(run, "_import_the_end_of_a_run", imported)
+    spec = run.build_spec("cartpole", "dqn", run_dir=tmp_path / "run", overrides={"max_episodes": 1})
+    with pytest.raises(Imported):
+        run.run_training(spec)
+    assert not (tmp_path / "run").exists()  # before anything is written
