@@ -310,7 +310,7 @@ def cmd_sweep(args) -> int:
 def cmd_report(args) -> int:
     from rlcore.extras import require
     from rlcore.report import KEPT_FILES, is_run_folder, keep, keep_runs, markdown, summarize
-    from rlcore.report_plots import plot_curves, plot_evals
+    from rlcore.report_plots import plot_critic, plot_curves, plot_evals
 
     require("rliable.metrics", "The report command")  # the sweep extra, or one line saying so
     folders = [Path(d) for d in args.sweep_dirs]
@@ -331,7 +331,8 @@ def cmd_report(args) -> int:
     first = folders[0]
     from rlcore.atomic import write_atomic
     write_atomic(first / "report.md", lambda p: p.write_text(text + "\n"))
-    pngs = [plot_curves(result, first / "report_curves.png"), plot_evals(result, first / "report_evals.png")]
+    pngs = [plot_curves(result, first / "report_curves.png"), plot_evals(result, first / "report_evals.png"),
+            plot_critic(result, first / "report_critic.png")]
     print(f"written: {first / 'report.md'}, {', '.join(str(p) for p in pngs if p)}")
     return 0
 

@@ -185,9 +185,11 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
                             description="Per run: the final evaluation on unseen seeds, env steps, wall time, "
                                         "and what its periodic evaluations saw (collapses, the weights kept). "
                                         "Over runs: mean, median and IQM with 95% stratified bootstrap CIs "
-                                        "(rliable's method); with two sweeps, P(first beats second). Writes "
-                                        "report.md, report_curves.png and, where runs evaluated periodically, "
-                                        "report_evals.png into the first sweep folder.")
+                                        "(rliable's method); with two sweeps, P(first beats second). Where runs "
+                                        "log a critic's Q (DQN family, SAC), each run's mean Q at its end beside "
+                                        "its largest return. Writes report.md, report_curves.png and, where runs "
+                                        "evaluated periodically or log Q, report_evals.png and report_critic.png "
+                                        "into the first sweep folder.")
     report.add_argument("sweep_dirs", nargs="+", metavar="SWEEP_DIR",
                         help="a sweep's folder (several: one report, compared); with --keep, finished run "
                              "folders of one recipe over seeds (main.py train ... --seed S) may be given instead")

@@ -7,6 +7,7 @@ TensorFlow-free."""
 from __future__ import annotations
 
 from rlcore import docgen_data  # its REPO and shipped_models read at each call (tests point them elsewhere)
+from rlcore.critic_trace import WINDOW, critic_cell, critic_trace
 from rlcore.eval_history import stability_summary, steps_text, story
 from rlcore.experiment import get_experiment
 
@@ -29,6 +30,12 @@ def _runs(folder: str, solved: float | None) -> list[tuple[dict, object]]:
         meta = docgen_data.read_json(meta_path)
         runs.append((meta, story(meta_path.parent.parent, meta, solved)))
     return sorted(runs, key=lambda run: run[0]["seed"])
+
+
+def _critic_traces(folder: str) -> dict:
+    """seed -> each finished run's critic over training (None for a run that logs no Q)."""
+    return {docgen_data.read_json(p)["seed"]: critic_trace(p.parent.parent)
+            for p in (docgen_data.REPO / folder).glob("*/model/meta.json")}
 
 
 def _kept_sweeps(experiment: str):
@@ -56,6 +63,8 @@ def sweep_stability(page: str, experiment: str) -> str:
             parts.append(f"**[{m.name}]({link(page, m.sweep.folder + '/report.md')})**: its runs made no periodic "
                          f"evaluations; each model holds its run's last weights.")
             continue
+        traces = _critic_traces(m.sweep.folder)
+        critic = all(t is not None for t in traces.values())  # a Q-learner: each seed's critic at its end
         rows = []
         for meta, st in runs:
             ev = meta.get("evaluation") or {}
@@ -66,16 +75,21 @@ def sweep_stability(page: str, experiment: str) -> str:
                          f"{sweep_score(st.best.mean, m)} at {steps_text(st.best.env_steps)}" if st.best else "–",
                          sweep_score(st.last.mean, m) if st.last else "–",
                          collapses_cell(st.collapses),
-                         f"{sweep_score(deepest.mean, m)} after {sweep_score(deepest.best_before, m)}" if deepest else "–"])
+                         f"{sweep_score(deepest.mean, m)} after {sweep_score(deepest.best_before, m)}" if deepest else "–"]
+                        + ([critic_cell(traces[meta["seed"]])] if critic else []))
         kept = [str(meta["seed"]) for meta, st in runs if st.kept_best]
         weights = ("" if len(kept) == len(runs) else
                    f" The models of seeds {', '.join(kept)} hold their best evaluation's weights (keep-best), the "
                    f"others their last." if kept else " Every model holds its run's last weights.")
         parts.append(f"**[{m.name}]({link(page, m.sweep.folder + '/report.md')})**: "
                      f"{stability_summary([st for _, st in runs])}{weights} Beside each unseen-seed score, the share "
-                     f"of its episodes that lasted to the time limit.\n\n"
-                     + table(["seed", "unseen seeds", "best evaluation (at)", "last", "collapses: at → back by",
-                              "deepest"], rows, "rrrrll"))
+                     f"of its episodes that lasted to the time limit."
+                     + (f" Last, the critic at the run's end: the mean Q of its training batches (median of its last "
+                        f"{WINDOW} episodes) beside the largest return of any of its training episodes; a critic "
+                        f"that diverged estimates returns far beyond any it was paid." if critic else "")
+                     + "\n\n" + table(["seed", "unseen seeds", "best evaluation (at)", "last", "collapses: at → back by",
+                                       "deepest"] + (["critic at the end: mean Q"] if critic else []), rows,
+                                      "rrrrll" + ("r" if critic else "")))
     return "\n\n".join([STABILITY_INTRO, *parts]) if parts else ""  # nothing until a sweep is kept
 
 

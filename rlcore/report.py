@@ -297,6 +297,8 @@ def markdown(result: dict) -> str:
                                                              for episodes, score in r["further"]) or "none")
                              for r in s["runs"]]
         lines += ["", *stability_lines(s["runs"]), ""]
+        if critic := critic_lines(s["runs"]):
+            lines += [*critic, ""]
     if "probability_of_improvement" in result:
         p, lo, hi = result["probability_of_improvement"]
         first, second = (s["label"] for s in result["sweeps"])
@@ -313,3 +315,16 @@ def stability_lines(runs: list[dict]) -> list[str]:
     lines = [f"Periodic evaluations (selection seeds): {stability_summary(stories)}", ""]
     lines += [f"- {r['trial']}: {story_text(r['story'])}" for r in runs]
     return lines
+
+
+def critic_lines(runs: list[dict]) -> list[str]:
+    """Each run's critic at its end beside the largest return it was paid (:mod:`rlcore.critic_trace`);
+    nothing for runs that log no Q."""
+    from rlcore.critic_trace import WINDOW, critic_cell, critic_trace
+
+    traces = [critic_trace(r["run_dir"]) for r in runs]
+    if all(t is None for t in traces):
+        return []
+    return [f"Critic: the mean Q of its training batches at the end of each run (median of its last {WINDOW} "
+            f"episodes), beside the largest return of any of its training episodes; report_critic.png draws "
+            f"it over training.", ""] + [f"- {r['trial']}: {critic_cell(t)}" for r, t in zip(runs, traces)]

@@ -111,3 +111,24 @@ def plot_evals(result: dict, out: Path, reps: int = 1000) -> Path | None:
             ax.plot([e.env_steps for e in evals], [e.mean for e in evals], lw=0.7, alpha=0.45,
                             color=line.get_color() if line else None)
     return _save_figure(fig, ax, "periodic evaluation, mean return", out)
+
+
+def plot_critic(result: dict, out: Path) -> Path | None:
+    """Each run's mean Q over env steps (:func:`rlcore.critic_trace.critic_trace`), one line per run on a
+    symmetric log scale, so a critic that diverges stands out by orders of magnitude. ``None`` (no file)
+    when no sweep's runs all log Q (A2C, PPO)."""
+    from rlcore.critic_trace import WINDOW, critic_trace
+
+    sweeps = []
+    for s in result["sweeps"]:
+        traces = [(r["trial"], critic_trace(r["run_dir"])) for r in s["runs"]]
+        if all(t is not None for _, t in traces):
+            sweeps.append((s["label"], traces))
+    if not sweeps:
+        return None
+    fig, ax = _figure()
+    for label, traces in sweeps:
+        for trial, t in traces:
+            ax.plot(t.env_steps, t.q, lw=1.0, label=trial if len(sweeps) == 1 else f"{label} {trial}")
+    ax.set_yscale("symlog", linthresh=1.0)
+    return _save_figure(fig, ax, f"mean Q of the training batches\n(median of {WINDOW} episodes)", out)

@@ -38,6 +38,7 @@ def readme_iqm_cell(name: str) -> str:
 def test_the_experiment_page_tells_each_kept_sweeps_collapses_as_its_evaluations_show_them(name):
     """The page's summary of collapses and keep-best (docgen's sweep-stability region) recomputed from the
     kept evals.csv files; and each seed's collapses are listed with where each fell and came back."""
+    from rlcore.critic_trace import critic_cell, critic_trace
     from rlcore.docgen_sweeps import collapses_cell
     from rlcore.eval_history import stability_summary
 
@@ -48,18 +49,23 @@ def test_the_experiment_page_tells_each_kept_sweeps_collapses_as_its_evaluations
     runs = load_runs(KEPT / name)
     assert section.startswith(stability_summary([r["story"] for r in runs]))
     rows = {line.split("|")[1].strip(): line for line in section.splitlines() if line.startswith("| ")}
+    traces = {r["seed"]: critic_trace(r["run_dir"]) for r in runs}
     for r in runs:
         assert f"| {collapses_cell(r['story'].collapses)} |" in rows[str(r["seed"])]
+        if all(traces.values()):  # a Q-learner's table ends with each seed's critic at the end of its run
+            assert rows[str(r["seed"])].rstrip().endswith(f"| {critic_cell(traces[r['seed']])} |")
+    assert ("critic at the end" in section) == all(traces.values())
 
 
 @pytest.mark.parametrize("name", SWEPT)
 def test_each_kept_report_tells_the_runs_stories_as_the_code_reads_them_now(name):
     """report.md is written once by `report --keep`; when the rule that reads evals.csv changes, the kept
     reports are written again (`main.py report results/sweeps/NAME`), and this says which are stale."""
-    from rlcore.report import stability_lines
+    from rlcore.report import critic_lines, stability_lines
 
     report = (KEPT / name / "report.md").read_text()
-    for line in stability_lines(load_runs(KEPT / name)):
+    runs = load_runs(KEPT / name)
+    for line in stability_lines(runs) + critic_lines(runs):
         assert line in report, f"{name}/report.md is stale: run `python main.py report results/sweeps/{name}`"
 
 
