@@ -74,8 +74,8 @@ def critic_cell(trace: CriticTrace | None) -> str:
     a trace."""
     if trace is None:
         return "–"
-    return f"{_q_text(trace.q_end)} (largest return {_q_text(trace.largest_return)})"
+    return f"{q_text(trace.q_end)} (largest return {q_text(trace.largest_return)})"
 
 
-def _q_text(value: float) -> str:
+def q_text(value: float) -> str:
     return f"{value:,.0f}" if abs(value) >= 100 else f"{value:.1f}" if abs(value) >= 10 else f"{value:.2f}"

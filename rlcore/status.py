@@ -164,6 +164,10 @@ def block_line(experiment, part: pd.DataFrame, partial: pd.DataFrame | None) -> 
     words.append(f"mean return {part['total_points'].mean():.1f}")
     if "episode_steps" in part:  # SAC: how long it stood (a Minitaur fall ends it early)
         words.append(f"mean length {part['episode_steps'].mean():,.0f} steps")
+    if "q_mean" in part and part["q_mean"].notna().any():  # a Q-learner's critic (rlcore/critic_trace.py)
+        from rlcore.critic_trace import q_text
+
+        words.append(f"median Q {q_text(part['q_mean'].median())}")
     if not success_key:  # Minitaur: x, the metres walked
         words += [f"mean {key} {part[key].mean():,.2f}" for key in experiment.info_keys
                   if key in part and part[key].notna().any()]

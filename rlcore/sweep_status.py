@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+from rlcore.critic_trace import critic_cell, critic_trace
 from rlcore.errors import UserError
 from rlcore.status import NO_BUDGET, evaluation_lines, pace, pace_text, run_record
 
@@ -33,6 +34,11 @@ def sweep_status(folder: str | Path) -> list[str]:
             left.append(NOT_STARTED)
             continue
         budgets.add((record.get("config") or {}).get("max_env_steps"))
+        try:
+            critic = critic_trace(trial)  # a Q-learner's critic now, beside the returns it was paid
+        except (OSError, ValueError, KeyError):  # a damaged table: the line without it
+            critic = None
+        critic_text = f"; critic: mean Q {critic_cell(critic)}" if critic else ""
         if "returns" not in record:  # a model's meta.json: finished
             if record.get("wall_seconds") and math.isfinite(record["env_steps"] / record["wall_seconds"]):
                 rates.append(record["env_steps"] / record["wall_seconds"])
@@ -41,7 +47,8 @@ def sweep_status(folder: str | Path) -> list[str]:
                          + (f", final score {final['final_score']:.2f} on unseen seeds"
                             if not math.isnan(final["final_score"]) else  # NaN: not evaluated
                             "; not evaluated on unseen seeds" + ("" if sweep.final_eval_episodes == 0 else
-                                                                 " yet (the sweep's --resume evaluates it)")))
+                                                                 " yet (the sweep's --resume evaluates it)"))
+                         + critic_text)
             continue
         try:
             measured = pace(trial / "metrics.csv", record)
@@ -51,7 +58,7 @@ def sweep_status(folder: str | Path) -> list[str]:
             measured, text, last = None, None, []
         lines.append(f"  {name}: checkpoint at {record['env_steps']:,} env steps, "
                      f"{record.get('wall_seconds', 0) / 3600:.1f} h" + (f", {text}" if text else "")
-                     + (f"; last {last[0]}" if last else ""))
+                     + (f"; last {last[0]}" if last else "") + critic_text)
         left.append(measured[1] if measured else None)
     budgets.discard(None)  # a record without its config says nothing of the budget
     budget = budgets.pop() if len(budgets) == 1 else None

@@ -339,8 +339,8 @@ def test_status_of_a_sweep_folder_is_a_line_per_trial(tmp_path, capsys):
     np.savez(running / "checkpoint.npz", state_json=np.frombuffer(json.dumps(state).encode(), np.uint8))
     # its pace over the last half hour of its clock (rows past the checkpoint count): 720 env steps in 1,800 s,
     # 0.4 env steps/s; the first row, slower, is older; 3,600 env steps to go from the checkpoint: 2.5 h
-    (running / "metrics.csv").write_text("episode,total_points,env_steps,wall_seconds\n1,0,10,1000\n2,0,100,5400\n"
-                                         "3,0,400,6500\n4,0,820,7200\n")
+    (running / "metrics.csv").write_text("episode,total_points,env_steps,wall_seconds,q_mean\n1,0,10,1000,\n"
+                                         "2,0,100,5400,1.5\n3,0.5,400,6500,2.5\n4,0,820,7200,3.5\n")
     (running / "evals.csv").write_text("env_steps,episode,eval_mean,eval_std,eval_time_limit_share\n"
                                        "500,9,3.25,0.5,0.4\n")
     code, out, err = run(capsys, "status", str(tmp_path / "st"))
@@ -349,7 +349,8 @@ def test_status_of_a_sweep_folder_is_a_line_per_trial(tmp_path, capsys):
         "sweep st: toy dqn, 3 trials",
         "  seed=0: finished at 1,200 env steps, final score 9.50 on unseen seeds",
         "  seed=1: checkpoint at 700 env steps, 2.0 h, 0.4 env steps/s lately, at most 2.5 h to its budget of 4,300 "
-        "env steps; last evaluation at env step 500: mean 3.25 +- 0.50, 40% of its episodes to the time limit",
+        "env steps; last evaluation at env step 500: mean 3.25 +- 0.50, 40% of its episodes to the time limit; "
+        "critic: mean Q 2.50 (largest return 0.50)",  # the median of the episodes that made gradient steps
         "  seed=2: not started",
         # seed 1: 3,600 env steps at 0.4/s = 2.5 h; seed 2: 4,300 at seed 0's 20 env steps/s = 0.06 h
         "at most about 2.6 h of training left, 1 trial at a time, at the paces seen (1 trial not started, at the "

@@ -7,8 +7,9 @@ from tests.test_cli import status_lines
 
 
 def test_status_of_a_minitaur_run_shows_length_distance_and_the_last_evaluations(capsys, tmp_path):
-    rows = ["episode,total_points,av_latest_points,target_ave_scores,env_steps,episode_steps,x,grad_steps"]
-    rows += [f"{i},{0.1 * i},0,15,{300 * i},{(i * 37) % 1000 + 1},{0.05 * i},{300 * i}" for i in range(1, 31)]
+    rows = ["episode,total_points,av_latest_points,target_ave_scores,env_steps,episode_steps,x,grad_steps,q_mean"]
+    rows += [f"{i},{0.1 * i},0,15,{300 * i},{(i * 37) % 1000 + 1},{0.05 * i},{300 * i},{(i * 7) % 5 / 4}"
+             for i in range(1, 31)]
     (tmp_path / "metrics.csv").write_text("\n".join(rows) + "\n")
     (tmp_path / "evals.csv").write_text(
         "env_steps,episode,eval_mean,eval_std,eval_time_limit_share\n"
@@ -23,7 +24,8 @@ def test_status_of_a_minitaur_run_shows_length_distance_and_the_last_evaluations
     for line, part in zip(lines[1:3], (df.iloc[10:20], df.iloc[20:30])):
         assert line == (f"episodes {part.episode.iloc[0]}-{part.episode.iloc[-1]} (to env step "
                         f"{part.env_steps.iloc[-1]:,}): mean return {part.total_points.mean():.1f} "
-                        f"mean length {part.episode_steps.mean():,.0f} steps mean x {part.x.mean():,.2f}")
+                        f"mean length {part.episode_steps.mean():,.0f} steps median Q {part.q_mean.median():.2f} "
+                        f"mean x {part.x.mean():,.2f}")
     assert lines[3:] == ["evaluation at env step 4,000: mean 1.25 +- 0.50, 10% of its episodes to the time limit",
                          "evaluation at env step 6,000: mean 2.00 +- 1.00, 30% of its episodes to the time limit",
                          "evaluation at env step 8,000: mean 3.50 +- 1.50, 60% of its episodes to the time limit"]
