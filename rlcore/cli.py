@@ -333,6 +333,9 @@ def cmd_report(args) -> int:
     write_atomic(first / "report.md", lambda p: p.write_text(text + "\n"))
     pngs = [plot_curves(result, first / "report_curves.png"), plot_evals(result, first / "report_evals.png"),
             plot_critic(result, first / "report_critic.png")]
+    for name, png in (("report_evals.png", pngs[1]), ("report_critic.png", pngs[2])):
+        if png is None:  # nothing to draw now: an earlier report's figure would describe other runs
+            (first / name).unlink(missing_ok=True)
     print(f"written: {first / 'report.md'}, {', '.join(str(p) for p in pngs if p)}")
     return 0
 

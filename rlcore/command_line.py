@@ -187,9 +187,9 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
                                         "Over runs: mean, median and IQM with 95% stratified bootstrap CIs "
                                         "(rliable's method); with two sweeps, P(first beats second). Where runs "
                                         "log a critic's Q (DQN family, SAC), each run's mean Q at its end beside "
-                                        "its largest return. Writes report.md, report_curves.png and, where runs "
-                                        "evaluated periodically or log Q, report_evals.png and report_critic.png "
-                                        "into the first sweep folder.")
+                                        "its largest return. Writes report.md and report_curves.png into the "
+                                        "first sweep folder, with report_evals.png where runs evaluated "
+                                        "periodically and report_critic.png where they log Q.")
     report.add_argument("sweep_dirs", nargs="+", metavar="SWEEP_DIR",
                         help="a sweep's folder (several: one report, compared); with --keep, finished run "
                              "folders of one recipe over seeds (main.py train ... --seed S) may be given instead")

@@ -5,8 +5,9 @@ A critic estimates discounted returns, so its mean Q stays within the scale of t
 seen; a critic that diverges does not (seed 2 of the Minitaur sweep: its mean Q rose from 0.2 at 160k env
 steps to about 3,000 at 1M, while no training episode returned more than 5.6). Nothing here draws a
 line between the two: the report and the docs print both numbers side by side and
-:func:`rlcore.report_plots.plot_critic` draws the curve. SAC's Q is soft (it holds the entropy bonus), so
-its first ~20k steps read high while the temperature is still near its initial 1. TensorFlow-free.
+:func:`rlcore.report_plots.plot_critic` draws the curve. The comparison holds at a run's end, not at its
+start: SAC's Q is soft (it holds the entropy bonus), so its first ~20k steps read high (about 54 against
+returns of about 3 on Minitaur) while the temperature is still near its initial 1. TensorFlow-free.
 """
 from __future__ import annotations
 
@@ -51,9 +52,9 @@ def critic_trace(run_dir: Path) -> CriticTrace | None:
         return None
     steps, q = [], []
     for row in rows:
-        value = _number(row[Q_COLUMN])
-        if value is not None:  # episodes before learning starts log an empty or nan Q
-            steps.append(float(row["env_steps"]))
+        value, step = _number(row[Q_COLUMN]), _number(row.get("env_steps"))
+        if value is not None and step is not None:  # episodes before learning starts log an empty or nan Q
+            steps.append(step)
             q.append(value)
     if not q:
         return None
@@ -70,11 +71,12 @@ def _number(text: str | None) -> float | None:
 
 
 def critic_cell(trace: CriticTrace | None) -> str:
-    """``3,010 (largest return 6.6)``: mean Q at the end beside the largest training return; ``–`` without
-    a trace."""
+    """``1,234 (largest return 5.67)``: mean Q at the end beside the largest training return (``–`` where
+    no return was logged); ``–`` without a trace."""
     if trace is None:
         return "–"
-    return f"{q_text(trace.q_end)} (largest return {q_text(trace.largest_return)})"
+    paid = "–" if math.isnan(trace.largest_return) else q_text(trace.largest_return)
+    return f"{q_text(trace.q_end)} (largest return {paid})"
 
 
 def q_text(value: float) -> str:

@@ -240,8 +240,8 @@ def region_curves(page: str, experiment: str) -> str:
                          f"band; each seed thin)**\n\n![{m.name} sweep evaluations]"
                          f"({link(page, m.sweep.folder + '/report_evals.png')}){{ width=\"60%\" }}")
         if m.sweep and (REPO / m.sweep.folder / "report_critic.png").is_file():
-            parts.append(f"**{m.name}, {len(m.sweep.seeds)} seeds: each seed's mean Q of its training batches (log "
-                         f"scale)**\n\n![{m.name} sweep critic]"
+            parts.append(f"**{m.name}, {len(m.sweep.seeds)} seeds: each seed's mean Q of its training batches, "
+                         f"running median of 20 episodes (log scale, linear within ±1)**\n\n![{m.name} sweep critic]"
                          f"({link(page, m.sweep.folder + '/report_critic.png')}){{ width=\"60%\" }}")
     return "\n\n".join(parts) or "*No curves shipped.*"
 

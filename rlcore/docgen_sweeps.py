@@ -64,7 +64,7 @@ def sweep_stability(page: str, experiment: str) -> str:
                          f"evaluations; each model holds its run's last weights.")
             continue
         traces = _critic_traces(m.sweep.folder)
-        critic = all(t is not None for t in traces.values())  # a Q-learner: each seed's critic at its end
+        critic = any(t is not None for t in traces.values())  # a Q-learner: each seed's critic at its end
         rows = []
         for meta, st in runs:
             ev = meta.get("evaluation") or {}
@@ -76,7 +76,7 @@ def sweep_stability(page: str, experiment: str) -> str:
                          sweep_score(st.last.mean, m) if st.last else "–",
                          collapses_cell(st.collapses),
                          f"{sweep_score(deepest.mean, m)} after {sweep_score(deepest.best_before, m)}" if deepest else "–"]
-                        + ([critic_cell(traces[meta["seed"]])] if critic else []))
+                        + ([critic_cell(traces.get(meta["seed"]))] if critic else []))
         kept = [str(meta["seed"]) for meta, st in runs if st.kept_best]
         weights = ("" if len(kept) == len(runs) else
                    f" The models of seeds {', '.join(kept)} hold their best evaluation's weights (keep-best), the "
@@ -85,8 +85,8 @@ def sweep_stability(page: str, experiment: str) -> str:
                      f"{stability_summary([st for _, st in runs])}{weights} Beside each unseen-seed score, the share "
                      f"of its episodes that lasted to the time limit."
                      + (f" Last, the critic at the run's end: the mean Q of its training batches (median of its last "
-                        f"{WINDOW} episodes) beside the largest return of any of its training episodes; a critic "
-                        f"that diverged estimates returns far beyond any it was paid." if critic else "")
+                        f"{WINDOW} episodes) beside the largest return of any of its training episodes; at a run's "
+                        f"end a critic that diverged estimates returns far beyond any it was paid." if critic else "")
                      + "\n\n" + table(["seed", "unseen seeds", "best evaluation (at)", "last", "collapses: at → back by",
                                        "deepest"] + (["critic at the end: mean Q"] if critic else []), rows,
                                       "rrrrll" + ("r" if critic else "")))

@@ -326,5 +326,6 @@ def critic_lines(runs: list[dict]) -> list[str]:
     if all(t is None for t in traces):
         return []
     return [f"Critic: the mean Q of its training batches at the end of each run (median of its last {WINDOW} "
-            f"episodes), beside the largest return of any of its training episodes; report_critic.png draws "
-            f"it over training.", ""] + [f"- {r['trial']}: {critic_cell(t)}" for r, t in zip(runs, traces)]
+            f"episodes), beside the largest return of any of its training episodes (– where a run logs no Q); "
+            f"report_critic.png draws that running median over training.", ""] + [
+        f"- {r['trial']}: {critic_cell(t)}" for r, t in zip(runs, traces)]

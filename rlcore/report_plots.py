@@ -114,21 +114,18 @@ def plot_evals(result: dict, out: Path, reps: int = 1000) -> Path | None:
 
 
 def plot_critic(result: dict, out: Path) -> Path | None:
-    """Each run's mean Q over env steps (:func:`rlcore.critic_trace.critic_trace`), one line per run on a
-    symmetric log scale, so a critic that diverges stands out by orders of magnitude. ``None`` (no file)
-    when no sweep's runs all log Q (A2C, PPO)."""
+    """Each run's mean Q over env steps (the running median of :func:`rlcore.critic_trace.critic_trace`),
+    one line per run that logs Q, on a log scale (linear within +-1, where Q may change sign), so a critic
+    that diverges stands out by orders of magnitude. ``None`` (no file) when no run logs Q (A2C, PPO)."""
     from rlcore.critic_trace import WINDOW, critic_trace
 
-    sweeps = []
-    for s in result["sweeps"]:
-        traces = [(r["trial"], critic_trace(r["run_dir"])) for r in s["runs"]]
-        if all(t is not None for _, t in traces):
-            sweeps.append((s["label"], traces))
-    if not sweeps:
+    lines = [(f"{s['label']} {r['trial']}" if len(result["sweeps"]) > 1 else r["trial"], critic_trace(r["run_dir"]))
+             for s in result["sweeps"] for r in s["runs"]]
+    lines = [(label, t) for label, t in lines if t is not None]
+    if not lines:
         return None
     fig, ax = _figure()
-    for label, traces in sweeps:
-        for trial, t in traces:
-            ax.plot(t.env_steps, t.q, lw=1.0, label=trial if len(sweeps) == 1 else f"{label} {trial}")
+    for label, t in lines:
+        ax.plot(t.env_steps, t.q, lw=1.0, label=label)
     ax.set_yscale("symlog", linthresh=1.0)
     return _save_figure(fig, ax, f"mean Q of the training batches\n(median of {WINDOW} episodes)", out)

@@ -74,3 +74,66 @@ def test_a_report_of_runs_without_a_critics_q_says_nothing_of_it(tmp_path, capsy
     code, _, err = run(capsys, "report", str(sweep), "--reps", "200")
     assert code == 0, err
     assert "Critic" not in (sweep / "report.md").read_text() and not (sweep / "report_critic.png").exists()
+
+
+def test_rows_without_env_steps_are_skipped_and_a_run_without_returns_says_so(tmp_path):
+    run_dir = tmp_path / "run"
+    run_dir.mkdir()
+    (run_dir / "metrics.csv").write_text("episode,env_steps,q_mean\n1,100,12.25\n2,,40.0\n3,300,14.75\n")
+    trace = critic_trace(run_dir)
+    assert trace.env_steps.tolist() == [100.0, 300.0] and trace.q_end == 13.5
+    assert critic_cell(trace) == "13.5 (largest return –)"  # a value from 10 to 100: one decimal
+
+
+def _sweep_of_mixed_runs(folder):
+    """Three finished runs with periodic evaluations; seeds 0 and 2 log Q, seed 1 does not."""
+    for seed in range(3):
+        run_dir = folder / f"seed={seed}"
+        if seed == 1:
+            run_dir.mkdir(parents=True)
+            (run_dir / "metrics.csv").write_text("episode,total_points,av_latest_points,env_steps\n1,2.0,2.0,100\n"
+                                                 "2,4.0,3.0,200\n")
+        else:
+            _metrics(run_dir, [1.0, 2.0, 7.5], [0.5, 1.0, 1.5 + 1000 * seed])
+        (run_dir / "model").mkdir()
+        (run_dir / "model" / "meta.json").write_text(json.dumps({
+            "experiment": "cartpole", "algo": "dqn", "seed": seed, "env_steps": 300, "wall_seconds": 2.0,
+            "evaluation": {"episodes": 30, "mean": 100.0 + seed}}))
+        (run_dir / "evals.csv").write_text("env_steps,episode,eval_mean,eval_std,eval_time_limit_share\n"
+                                           "100,1,10.0,1.0,0.0\n200,2,20.0,1.0,0.0\n")
+    return folder
+
+
+def test_a_sweep_whose_runs_log_q_and_runs_that_do_not_shows_each_that_does(tmp_path, capsys):
+    sweep = _sweep_of_mixed_runs(tmp_path / "mixed")
+    (sweep / "report_critic.png").write_bytes(b"an earlier report's figure")
+    code, _, err = run(capsys, "report", str(sweep), "--reps", "200")
+    assert code == 0, err
+    report = (sweep / "report.md").read_text()
+    assert "- seed=0: 1.00 (largest return 7.50)" in report and "- seed=1: –" in report
+    assert "- seed=2: 1.00 (largest return 7.50)" in report  # the median of 0.5, 1.0 and 2,001.5
+    assert (sweep / "report_critic.png").read_bytes().startswith(b"\x89PNG")
+    for seed in (0, 2):  # without the Q-learners, nothing to draw: the earlier figure goes
+        (sweep / f"seed={seed}" / "metrics.csv").write_text("episode,total_points,av_latest_points,env_steps\n"
+                                                          "1,2.0,2.0,100\n")
+    code, _, err = run(capsys, "report", str(sweep), "--reps", "200")
+    assert code == 0, err
+    assert not (sweep / "report_critic.png").exists() and "Critic" not in (sweep / "report.md").read_text()
+
+
+def test_the_docs_table_of_a_mixed_sweep_gives_each_seeds_critic_or_a_dash(tmp_path, monkeypatch):
+    from rlcore import docgen, docgen_data, docgen_sweeps  # noqa: F401  (imported before REPO moves)
+    from rlcore.experiment import get_experiment
+
+    _sweep_of_mixed_runs(tmp_path / "results" / "sweeps" / "cartpole__dqn")
+    monkeypatch.setattr(docgen_data, "REPO", tmp_path)
+    kept = docgen_data.Sweep("results/sweeps/cartpole__dqn", [(0, 100.0), (1, 101.0), (2, 102.0)], {})
+    model = docgen_data.Model("cartpole", "dqn", "saved_networks/cartpole/dqn",
+                              {"algo": "dqn", "seed": 0, "evaluation": {"episodes": 100, "mean": 500.0}},
+                              get_experiment("cartpole").bar("dqn"), kept)
+    monkeypatch.setattr(docgen_data, "shipped_models", lambda: [model])
+    rows = [line for line in docgen_sweeps.sweep_stability("docs/x.md", "cartpole").splitlines()
+            if line.startswith("| ")]
+    assert rows[0].endswith("| critic at the end: mean Q |") and rows[1].count("|") == rows[0].count("|")
+    cells = {row.split("|")[1].strip(): row.split("|")[-2].strip() for row in rows[2:]}
+    assert cells == {"0": "1.00 (largest return 7.50)", "1": "–", "2": "1.00 (largest return 7.50)"}
