@@ -52,6 +52,37 @@ def test_interrupt_then_resume_continues_the_counters(algo, tmp_path, monkeypatc
 
 
 
+@pytest.mark.parametrize("algo", ["dqn", "sac"])
+def test_a_resume_differs_from_the_run_that_never_stopped_only_in_its_envs_episodes(algo, tmp_path, monkeypatch):
+    """A resume starts its next episode on a seed drawn from the run's seed and its episode count
+    (rlcore/seeding.py), where the run that never stopped goes on with its env's own random stream.
+    With the toy env made to seed every episode that way, an interrupted and resumed run (stopped at an
+    episode's end) is the uninterrupted run, row for row: weights, optimizers, RNG, replay memory, the
+    temperature and every counter come back as they were. Both runs are computed here, on one machine."""
+    env_class = {"dqn": toy.SignEnv, "sac": toy.ReachEnv}[algo]
+    reset = env_class.reset
+
+    def reset_seeding_each_episode(self, *, seed=None, options=None):
+        if seed is None:  # the next episode: the seed a resume would draw (training_env_seed(0, i) = i)
+            self.resets_since += 1
+            seed = self.last_seed + self.resets_since
+        else:
+            self.last_seed, self.resets_since = seed, 0
+        return reset(self, seed=seed, options=options)
+    monkeypatch.setattr(env_class, "reset", reset_seeding_each_episode)
+    kw = {"stop_score": 99.0, "max_episodes": 30,
+          **({"max_env_steps": 0, "learning_starts": 100, "obs_norm": True} if algo == "sac" else {})}
+    never_stopped = toy.spec(algo, tmp_path / "a", **kw)
+    TRAINERS[algo].train(never_stopped)
+    resumed = toy.spec(algo, tmp_path / "b", **kw)
+    _interrupt_after(12, TRAINERS[algo], resumed)
+    resumed.resume, resumed.command = True, "pytest --resume"
+    TRAINERS[algo].train(resumed)
+    a, b = (pd.read_csv(spec.run_dir / "metrics.csv").drop(columns="wall_seconds") for spec in (never_stopped, resumed))
+    assert len(a) == len(b) == 30
+    pd.testing.assert_frame_equal(a, b, check_exact=True)
+
+
 def _watch_sac_temperature(monkeypatch) -> list[float]:
     """log_alpha as each SAC update call finds it, in call order."""
     from rlcore.agents.sac import SACAgent
