@@ -274,11 +274,16 @@ def region_meta_keys(page: str, arg: str) -> str:
 
 
 def region_bars(page: str, arg: str) -> str:
-    """Every bar in the registry with its reason."""
+    """Every bar in the registry with its reason, and where one is set, the recipe's bar over seeds (its
+    kept sweep's statistic) with its own."""
     rows = []
     for name in experiment_names():
         for model, bar in get_experiment(name).bars.items():
             rows.append([name, model, bar.describe(), bar.reason])
+            if bar.over_seeds:
+                seeds = bar.over_seeds
+                rows.append([name, f"{model}, its recipe over seeds",
+                             seeds.describe(bar.metric == "success_share"), seeds.reason])
     return table(["experiment", "model", "bar", "why this number"], rows)
 
 

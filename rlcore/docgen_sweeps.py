@@ -103,12 +103,23 @@ def seed_summary(page: str, experiment: str) -> str:
         parts.append(f"{m.title}, the same recipe over {len(m.sweep.seeds)} seeds "
                      f"([report]({link(page, m.sweep.folder + '/report.md')})): IQM [95% CI] **{iqm_text(m)}**; "
                      f"per seed {per_seed}; the shipped model (seed {m.meta.get('seed')}, a run of its own) "
-                     f"{score_text(m)}."
+                     f"{score_text(m)}." + seeds_bar_text(m)
                      + (f" During training {stability_summary([st for _, st in runs])}"
                         if any(st.evaluations for _, st in runs) else ""))
     if not parts:
         return "*Not kept in `results/sweeps/` yet: the figures appear here when the runs are.*"
     return "\n\n".join(parts)
+
+
+def seeds_bar_text(m) -> str:
+    """`` Bar over seeds: IQM >= 11.3 (why): **met**.``, from the registry's bar for the recipe over seeds
+    (:class:`rlcore.experiment.SeedsBar`) and the kept sweep's report; empty where none is set."""
+    bar = m.bar.over_seeds if m.bar else None
+    if bar is None or bar.statistic not in m.sweep.aggregates:
+        return ""
+    met = bar.met_by(m.sweep.aggregates[bar.statistic][0], [score for _, score in m.sweep.seeds])
+    return (f" Bar over seeds: {bar.describe('success_share' in m.evaluation)} ({bar.reason}): "
+            f"**{'met' if met else 'not met'}**.")
 
 
 def _hours(seconds: float) -> str:

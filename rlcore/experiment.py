@@ -34,6 +34,28 @@ class AlgoSpec:
 
 
 @dataclass(frozen=True)
+class SeedsBar:
+    """What the shipped model's recipe must reach over seeds (its sweep, kept in ``results/sweeps/``), and
+    why: the ``statistic`` (``iqm`` or ``median``, as ``main.py report`` computes it) of the seeds' scores
+    at least ``value``, and, with ``least``, every seed at least that. Scores as the model's :class:`Bar`
+    reads them."""
+    statistic: str
+    value: float
+    reason: str
+    least: float | None = None
+
+    def met_by(self, point: float, scores: list[float]) -> bool:
+        """Whether a sweep clears it: ``point``, the statistic over its seeds; ``scores``, each seed's."""
+        return point >= self.value and (self.least is None or min(scores) >= self.least)
+
+    def describe(self, share: bool) -> str:
+        """``IQM >= 11.3`` or ``median >= 80%, every seed >= 50%`` (``share``: scores are success shares)."""
+        show = (lambda v: f"{v:.0%}") if share else (lambda v: f"{v:g}")
+        name = "IQM" if self.statistic == "iqm" else self.statistic
+        return f"{name} >= {show(self.value)}" + ("" if self.least is None else f", every seed >= {show(self.least)}")
+
+
+@dataclass(frozen=True)
 class Bar:
     """What a shipped model must reach in its evaluation on unseen seeds, and why that number.
 
@@ -45,6 +67,7 @@ class Bar:
     value: float
     reason: str
     full_length_share: float | None = None
+    over_seeds: SeedsBar | None = None  # what the recipe must reach over seeds, where a bar is set for it
 
     def met_by(self, evaluation: dict) -> bool:
         """Whether a recorded evaluation (meta.json's ``evaluation``) clears the bar."""

@@ -148,3 +148,33 @@ def test_a_seeds_score_gives_its_full_length_share_where_the_bar_asks_for_one():
     assert evaluation_cell(walked, minitaur) == "18.6 over 30 (93% full length)"
     assert evaluation_cell(walked, lander) == "18.6 over 30"  # its bar asks for no such share
     assert evaluation_cell({"mean": 18.56, "episodes": 30}, minitaur) == "18.6 over 30"  # not recorded
+
+
+def test_a_headline_recipe_is_held_to_its_bar_over_seeds_and_the_summary_says_whether_it_met_it():
+    """Issue 49's bars, declared in the registry beside each shipped model's bar: Minitaur's IQM over 5
+    seeds at least 11.3; Mario 1-1's median flag share over 3 seeds at least 8 of 10 and every seed at
+    least 5 of 10. The README's seed summary says met or not met from the kept sweep's report."""
+    from types import SimpleNamespace
+
+    from rlcore.docgen_sweeps import seeds_bar_text
+    from rlcore.experiment import get_experiment
+
+    minitaur = get_experiment("minitaur").bar("sac").over_seeds
+    mario = get_experiment("mario_ppo").bar("1-1").over_seeds
+    assert get_experiment("mario_ppo").bar("1-2").over_seeds is None
+    assert minitaur.met_by(11.3, [0.9, 30.0]) and not minitaur.met_by(11.29, [20.0] * 5)
+    assert mario.met_by(0.8, [0.5, 0.8, 0.9]) and not mario.met_by(0.9, [0.4, 0.9, 1.0])  # one seed below 5 of 10
+    assert not mario.met_by(0.7, [0.6, 0.7, 1.0])
+    assert minitaur.describe(share=False) == "IQM >= 11.3"
+    assert mario.describe(share=True) == "median >= 80%, every seed >= 50%"
+
+    def model(bar, evaluation, aggregates, seeds):
+        return SimpleNamespace(bar=bar, evaluation=evaluation,
+                               sweep=SimpleNamespace(aggregates=aggregates, seeds=list(enumerate(seeds))))
+    walk = model(get_experiment("minitaur").bar("sac"), {"mean": 20.45}, {"iqm": (13.4, 0.9, 20.8)}, [18.6, 20.8, 0.9])
+    assert seeds_bar_text(walk) == f" Bar over seeds: IQM >= 11.3 ({minitaur.reason}): **met**."
+    flags = model(get_experiment("mario_ppo").bar("1-1"), {"success_share": 0.8}, {"median": (0.9, 0.6, 1.0)},
+                  [0.9, 1.0, 0.4])
+    assert seeds_bar_text(flags).endswith("): **not met**.")
+    assert seeds_bar_text(model(get_experiment("lunar_lander").bar("dqn"), {"mean": 270.7}, {"iqm": (257.4, 0, 0)},
+                                [270.7] * 5)) == ""  # no bar over seeds set
