@@ -86,6 +86,8 @@ def cmd_train(args) -> int:
         _render(model_dir, model_dir / f"{folder_safe(spec.experiment.name)}_{spec.algo}.mp4", None, None, None)
     if args.publish:
         target = shipping.shipped_dir(spec.experiment.name, spec.algo, spec.config)
+        if why := shipping.publish_refusal(spec.experiment, target, meta):
+            raise UserError(f"not published to {target}/: {why}; the model stays in {model_dir}/")
         shipping.publish(model_dir, target)
         print(f"published to {target}/")
     return 0

@@ -108,7 +108,8 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
                             "(default 100; Mario 10; 0 = none)")
     train.add_argument("--video", action="store_true", help="also render an MP4 of the trained agent")
     train.add_argument("--publish", action="store_true",
-                       help="copy the trained model into saved_networks/EXPERIMENT/ALGO/")
+                       help="copy the trained model into saved_networks/EXPERIMENT/ALGO/, replacing the "
+                            "shipped one, if its evaluation on unseen seeds meets that model's bar")
     train.add_argument("--no-progress", action="store_true", help="no progress bar")
     _add_hyperparameters(train, argv)
 

@@ -207,6 +207,19 @@ def evaluate_further_into_meta(model_dir: Path, episodes: int, seed_base: int | 
     return meta
 
 
+def publish_refusal(experiment, target: Path, meta: dict) -> str | None:
+    """Why a finished run's model (its ``meta``) may not become the shipped model at ``target``: it has
+    no evaluation on unseen seeds, or that evaluation misses the bar of the model it would replace
+    (``experiment.bar``). None: it may."""
+    evaluation = meta.get("evaluation")
+    if not evaluation:
+        return "it has no evaluation on unseen seeds (it was trained with --final-eval-episodes 0)"
+    bar = experiment.bar(target.name)
+    if bar is not None and not bar.met_by(evaluation):
+        return f"its evaluation misses the bar of the shipped {target.name} ({bar.describe()})"
+    return None
+
+
 def publish(model_dir: Path, target: Path) -> None:
     """Make ``target`` (a saved_networks/ folder) an exact copy of ``model_dir``, replacing it whole
     (:func:`rlcore.atomic.replace_folder`: files of an earlier model that the new one lacks do not

@@ -301,3 +301,34 @@ def test_a_new_run_into_a_folder_that_holds_a_run_is_refused_and_leaves_it_as_it
     assert sorted(p.name for p in run_dir.iterdir()) == ["checkpoint.npz", "metrics.csv"]
     assert (run_dir / "checkpoint.npz").read_bytes() == b"a checkpoint"
     assert (run_dir / "metrics.csv").read_text() == "episode,total_points\n1,2.0\n"
+
+
+def test_publish_refuses_a_model_that_misses_the_bar_of_the_one_it_would_replace(capsys, tmp_path, monkeypatch):
+    """A short run with --publish must not replace a shipped model that meets its bar (a new user's
+    `train cartpole dqn --episodes 8 --publish` did): one line, exit 2, the shipped folder untouched."""
+    shipped = tmp_path / "models" / "cartpole" / "dqn"
+    shipped.mkdir(parents=True)
+    (shipped / "meta.json").write_text("the shipped model")
+    monkeypatch.setenv("DEEPRL_MODELS", str(tmp_path / "models"))
+    run_dir = tmp_path / "run"
+    code, out, err = run(capsys, "train", "cartpole", "dqn", "--episodes", "3", "--final-eval-episodes", "2",
+                         "--wandb", "off", "--no-progress", "--run-dir", str(run_dir), "--publish")
+    assert code == 2, (out, err)
+    assert err.strip() == (f"error: not published to {shipped}/: its evaluation misses the bar of the shipped dqn "
+                           f"(mean return >= 500); the model stays in {run_dir / 'model'}/")
+    assert [p.name for p in shipped.iterdir()] == ["meta.json"] and (shipped / "meta.json").read_text() == "the shipped model"
+    assert (run_dir / "model" / "meta.json").is_file()
+
+
+def test_publish_refusal_reads_the_bar_of_the_folder_it_would_replace():
+    from rlcore.experiment import get_experiment
+    from rlcore.shipping import publish_refusal
+
+    lander, mario = get_experiment("lunar_lander"), get_experiment("mario_ppo")
+    assert publish_refusal(lander, Path("saved/lunar_lander/dqn"), {"evaluation": {"mean": 231.0}}) is None
+    assert "misses the bar of the shipped a2c (mean return >= 200)" in publish_refusal(
+        lander, Path("saved/lunar_lander/a2c"), {"evaluation": {"mean": 199.0}})
+    assert "no evaluation on unseen seeds" in publish_refusal(lander, Path("saved/lunar_lander/dqn"), {})
+    flags = {"evaluation": {"success_share": 0.6, "episodes": 10}}  # 6 of 10: enough for 1-2, not for 1-1
+    assert publish_refusal(mario, Path("saved/mario_ppo/1-2"), flags) is None
+    assert "1-1 (success in >= 80% of episodes)" in publish_refusal(mario, Path("saved/mario_ppo/1-1"), flags)
