@@ -117,6 +117,13 @@ def whole_number(allowed: Allowed):
     return parse
 
 
+def check_whole(name: str, value, allowed: Allowed) -> None:
+    """A whole-number argument of the Python API (``seed=``, ``episodes=`` ...), checked as
+    :func:`whole_number` checks it on the command line: :class:`UserError` naming it otherwise."""
+    if isinstance(value, bool) or not isinstance(value, int) or not allowed.accepts(value):
+        raise UserError(f"{name}={value!r} is invalid: allowed is {allowed.describe().replace('a number', 'a whole number', 1)}")
+
+
 def require(condition: bool, message: str) -> None:
     """A rule between fields (e.g. the minibatch divides the rollout), checked in ``__post_init__``."""
     if not condition:

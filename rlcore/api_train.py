@@ -10,6 +10,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Iterator, Literal
 
+from rlcore.allowed import COUNT, check_whole
+from rlcore.command_line import FINAL_EVALUATION, RUN_SEEDS
 from rlcore.errors import UserError
 
 if TYPE_CHECKING:
@@ -66,6 +68,8 @@ def train(env: str, algo: str, *, preset: str | None = None, seed: int = 0,
     from rlcore.run import build_spec, check_new_run_dir
     from rlcore.trainers.spec import new_run_dir
 
+    check_whole("seed", seed, RUN_SEEDS)  # as the command line checks them, before any folder exists
+    _check_budgets(episodes, steps, final_eval_episodes)
     require_experiment(env)  # a missing extra (mario, minitaur): one line, before any folder exists
     load_tensorflow()
     overrides = _overrides(hyperparameters, episodes, steps)
@@ -98,6 +102,7 @@ def resume(run: str | os.PathLike[str] | Run, *, episodes: int | None = None, st
     from rlcore.run import build_spec
     from rlcore.trainers.spec import CHECKPOINT_FILE
 
+    _check_budgets(episodes, steps, final_eval_episodes)
     folder = Path(run.run_dir if isinstance(run, Run) else run)
     if not (folder / CHECKPOINT_FILE).is_file():
         raise UserError(f"{folder} holds no {CHECKPOINT_FILE} to resume from; give the folder of a run "
@@ -113,6 +118,15 @@ def resume(run: str | os.PathLike[str] | Run, *, episodes: int | None = None, st
     return _train_and_evaluate(spec, f"resuming {folder} at episode {len(state['returns'])}, env step "
                                      f"{state['env_steps']}{resuming_changes(spec.changes)}", final_eval_episodes,
                                callback, progress)
+
+
+def _check_budgets(episodes: int | None, steps: int | None, final_eval_episodes: int | None) -> None:
+    """``episodes``, ``steps`` and ``final_eval_episodes`` as ``--episodes``, ``--steps`` and
+    ``--final-eval-episodes`` are checked (None: not given)."""
+    for name, value, allowed in (("episodes", episodes, COUNT), ("steps", steps, COUNT),
+                                 ("final_eval_episodes", final_eval_episodes, FINAL_EVALUATION)):
+        if value is not None:
+            check_whole(name, value, allowed)
 
 
 def _overrides(hyperparameters: dict[str, Any], episodes: int | None, steps: int | None) -> dict[str, Any]:

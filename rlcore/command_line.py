@@ -31,9 +31,11 @@ def folder_name(text: str) -> str:
 PRESET_HELP = ("a named set of hyperparameters: article, default, or another that `list` shows "
                "(default: default)")
 COUNT, NON_NEGATIVE = whole_number(allowed.COUNT), whole_number(allowed.NON_NEGATIVE)
-SEED = whole_number(Allowed(low=0, high=MAX_RUN_SEED))
-EVAL_EPISODES = whole_number(Allowed(low=1, high=MAX_EVAL_EPISODES))  # one unseen seed per episode
-FINAL_EVAL_EPISODES = whole_number(Allowed(low=0, high=MAX_EVAL_EPISODES))
+RUN_SEEDS = Allowed(low=0, high=MAX_RUN_SEED)
+FINAL_EVALUATION = Allowed(low=0, high=MAX_EVAL_EPISODES)  # one unseen seed per episode; 0 = none
+SEED = whole_number(RUN_SEEDS)
+EVAL_EPISODES = whole_number(Allowed(low=1, high=MAX_EVAL_EPISODES))
+FINAL_EVAL_EPISODES = whole_number(FINAL_EVALUATION)
 
 
 EXAMPLES = """examples:

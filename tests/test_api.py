@@ -49,6 +49,21 @@ def test_load_mistakes_are_user_errors(model, message):
         api.load(model)
 
 
+@pytest.mark.parametrize("kwargs, message", [
+    ({"seed": -1}, "seed=-1 is invalid: allowed is a whole number from 0 to 900"),
+    ({"seed": 901}, "seed=901 is invalid"), ({"seed": 2.5}, "seed=2.5 is invalid"), ({"seed": "3"}, "seed='3' is invalid"),
+    ({"final_eval_episodes": -1}, "final_eval_episodes=-1 is invalid"), ({"episodes": 0}, "episodes=0 is invalid"),
+    ({"steps": True}, "steps=True is invalid"),
+])
+def test_train_checks_its_arguments_as_the_command_line_does_before_any_folder_exists(tmp_path, kwargs, message):
+    with pytest.raises(UserError, match=message):
+        api.train("cartpole", "dqn", run_dir=tmp_path / "run", **{"episodes": 2, **kwargs})
+    assert not (tmp_path / "run").exists()
+    if "seed" not in kwargs:  # resume takes the budgets too, and checks them before it reads the folder
+        with pytest.raises(UserError, match=message):
+            api.resume(tmp_path / "run", **kwargs)
+
+
 def test_train_records_the_call_evaluates_and_renders(tmp_path):
     rows = []
     run = api.train("cartpole", "dqn", run_dir=tmp_path / "run", episodes=4, final_eval_episodes=3, seed=2,
