@@ -107,3 +107,29 @@ def test_the_same_flags_with_what_they_need_are_accepted():
     for given in ({"restart_x": 500, "restart_share": 0.3}, {"restart_every": 400, "restart_weights": "deaths"},
                   {"restart_x": 500, "restart_back_step": 50, "restart_goal_x": 900, "restart_back_share": 0.4}):
         check_no_inert(apply_overrides(mario, given), given)
+
+
+def test_a_finished_run_resumed_with_nothing_left_to_train_is_refused_and_left_as_it_was(capsys, tmp_path):
+    """A new user's `--resume RUN --episodes 2` of a run finished at 3 episodes trained nothing, evaluated
+    again and recorded a resume that did nothing; now one line, exit 2, files untouched. A larger budget
+    goes on."""
+    run_dir = tmp_path / "run"
+    code, out, err = run(capsys, "train", "cartpole", "dqn", "--episodes", "3", "--final-eval-episodes", "1",
+                         "--wandb", "off", "--no-progress", "--run-dir", str(run_dir))
+    assert code == 0, err
+    before = {p.name: p.read_bytes() for p in (run_dir / "model").iterdir()} | {
+        p.name: p.read_bytes() for p in run_dir.iterdir() if p.is_file() and p.name != ".lock"}
+    for budget in (["--episodes", "2"], ["--episodes", "3"], ["--lr", "0.001"]):
+        code, out, err = run(capsys, "train", "cartpole", "dqn", "--resume", str(run_dir), *budget,
+                             "--final-eval-episodes", "1", "--wandb", "off", "--no-progress")
+        assert code == 2, (budget, out, err)
+        assert err.strip().startswith(f"error: nothing to train: the run in {run_dir} is finished, and what ended it "
+                                      f"still holds (--max-episodes ")
+        assert err.strip().endswith("give a larger budget (--episodes or --steps) or change that setting")
+    after = {p.name: p.read_bytes() for p in (run_dir / "model").iterdir()} | {
+        p.name: p.read_bytes() for p in run_dir.iterdir() if p.is_file() and p.name != ".lock"}
+    assert after == before
+    code, out, err = run(capsys, "train", "cartpole", "dqn", "--resume", str(run_dir), "--episodes", "4",
+                         "--final-eval-episodes", "1", "--wandb", "off", "--no-progress")
+    assert code == 0, err
+    assert json.loads((run_dir / "model" / "meta.json").read_text())["episodes"] == 4
