@@ -13,6 +13,7 @@ installed ``deeprl`` script and a checkout's ``main.py`` both call :func:`main`.
 from __future__ import annotations
 
 import contextlib
+import importlib
 import json
 import os
 import sys
@@ -358,7 +359,15 @@ def _register_recorded_env(model: str | None) -> None:
     for meta_path in (Path(model) / "meta.json", Path(model) / "model" / "meta.json"):
         if meta_path.is_file():
             with contextlib.suppress(ValueError, OSError):
-                register_from_record(json.loads(meta_path.read_text()).get("env") or {})
+                meta = json.loads(meta_path.read_text())
+                module = str(meta.get("experiment")).partition(":")[0] if ":" in str(meta.get("experiment")) else None
+                try:  # trained as MODULE:ID: the module registers it, as it did then (once: no second register)
+                    if module:
+                        importlib.import_module(module)
+                        return
+                except ImportError:
+                    pass  # not importable here: the record's entry point may still be
+                register_from_record(meta.get("env") or {})
             return
 
 

@@ -127,15 +127,18 @@ def _run_savedmodel(path: Path, obs: np.ndarray) -> np.ndarray:
 
 
 def _run_tflite(path: Path, obs: np.ndarray) -> np.ndarray:
+    from rlcore.quiet import filtered_stderr
+
     try:
         from ai_edge_litert.interpreter import Interpreter
     except ImportError:
         import tensorflow as tf
         Interpreter = tf.lite.Interpreter
-    interpreter = Interpreter(model_path=str(path))
-    given = interpreter.get_input_details()[0]
-    interpreter.resize_tensor_input(given["index"], list(obs.shape))
-    interpreter.allocate_tensors()
+    with filtered_stderr():  # LiteRT announces its XNNPACK delegate when it plans the tensors
+        interpreter = Interpreter(model_path=str(path))
+        given = interpreter.get_input_details()[0]
+        interpreter.resize_tensor_input(given["index"], list(obs.shape))
+        interpreter.allocate_tensors()
     interpreter.set_tensor(given["index"], obs)
     interpreter.invoke()
     return np.array(interpreter.get_tensor(interpreter.get_output_details()[0]["index"]))

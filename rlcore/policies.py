@@ -15,9 +15,14 @@ from rlcore.sampling import sample_categorical, softmax
 def read_meta(model_dir: str | Path) -> dict:
     model_dir = Path(model_dir)
     meta_path = model_dir / "meta.json"
+    if not model_dir.exists():
+        raise UserError(f"{model_dir}: no such model folder")
+    if not model_dir.is_dir():
+        raise UserError(f"{model_dir} is a file; give the model folder that holds it ({model_dir.parent})"
+                        if model_dir.name == "meta.json" else f"{model_dir} is a file, not a model folder")
     if not meta_path.is_file():
-        raise UserError(f"{model_dir} has no meta.json: not a model folder of this package "
-                        "(train one with `main.py train`, or pass --model)")
+        raise UserError(f"{model_dir} has no meta.json: not a model folder of this package (a run's model/ "
+                        "folder, or a shipped one under saved_networks/)")
     try:
         return json.loads(meta_path.read_text())
     except json.JSONDecodeError as exc:
@@ -41,7 +46,12 @@ def load_policy(model_dir: str | Path, experiment: str | None = None, algo: str 
     """
     meta = read_meta(model_dir)
     for key, wanted in (("experiment", experiment), ("algo", algo)):
-        if wanted is not None and meta.get(key) != wanted:
+        recorded = meta.get(key)
+        if key == "experiment" and isinstance(recorded, str) and ":" in recorded:
+            recorded_as = {recorded, recorded.split(":", 1)[1]}  # a user's MODULE:ID env, named by its id too
+        else:
+            recorded_as = {recorded}
+        if wanted is not None and wanted not in recorded_as:
             raise UserError(f"model in {model_dir} is {meta.get('experiment')} {meta.get('algo')}, "
                             f"not {experiment} {algo}")
     exp = get_experiment(meta["experiment"], meta.get("env"))

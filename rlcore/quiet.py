@@ -27,7 +27,14 @@ NOISE = re.compile("|".join([
     r"^argv\[0\]=$",
     r"^pybullet build time: ",
     r"^Token authentication is enabled for this Ray cluster\.",  # local Ray keeps its token; no news
+    r"^INFO: Created TensorFlow Lite XNNPACK delegate for CPU\.$",  # LiteRT, each interpreter (export check)
 ]))
+
+# SDL (pygame, which Gymnasium's classic-control and Box2D envs draw their frames with) starts a video
+# driver and, on a machine without a display, prints "error: XDG_RUNTIME_DIR is invalid or not set": there
+# no window can open anyway, and frames for a video need none, so SDL gets its dummy driver
+if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+    os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 
 
 def keep(line: str) -> bool:

@@ -40,7 +40,7 @@ def test_mario_level_by_name():
     (("lunar_lander", "sac"), "unknown algorithm 'sac'"),
     (("moon_lander", "dqn"), "unknown experiment 'moon_lander'"),
     (("mario_ppo", "8-4"), "no shipped model mario_ppo 8-4"),
-    ("/nonexistent/model", "has no meta.json"),
+    ("/nonexistent/model", "/nonexistent/model: no such model folder"),
 ])
 def test_load_mistakes_are_user_errors(model, message):
     if model[0] == "mario_ppo":

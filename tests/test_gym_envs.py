@@ -126,6 +126,12 @@ def test_user_env_module_trains_learns_and_loads_in_a_fresh_process(tmp_path):
                           timeout=120, env={**os.environ, "PYTHONPATH": str(ROOT)})
     assert done.returncode == 0, done.stderr[-2000:]
     assert float(done.stdout.strip().splitlines()[-1]) >= 17.0
+    for name in ("tests.user_env:Chase-v0", "Chase-v0"):  # the CLI takes the env as trained, or by its id
+        done = subprocess.run([sys.executable, str(ROOT / "main.py"), "evaluate", name, "ppo", "--model",
+                               str(run.run_dir), "--episodes", "2"], cwd=tmp_path, capture_output=True, text=True,
+                              timeout=120, env={**os.environ, "PYTHONPATH": str(ROOT)})
+        assert done.returncode == 0, done.stderr[-2000:]
+        assert "over 2 episodes" in done.stdout and "Overriding environment" not in done.stderr, done.stderr
 
 
 def test_registered_by_id_alone_reloads_from_its_record(tmp_path, capsys):
