@@ -5,6 +5,7 @@ A crash or Ctrl-C mid-write leaves the previous good file in place, never a half
 from __future__ import annotations
 
 import contextlib
+import errno
 import json
 import os
 import tempfile
@@ -23,7 +24,10 @@ def writable_folder(folder: str | os.PathLike, what: str) -> Path:
         with tempfile.TemporaryFile(dir=folder):
             pass
     except OSError as exc:
-        raise UserError(f"{what} {folder}: cannot write there ({exc.strerror or exc})") from None
+        reason = exc.strerror or str(exc)
+        if exc.errno == errno.ENOENT and folder.is_dir():  # /proc, /sys: the folder is there, a new file is not
+            reason = "the folder takes no new files"
+        raise UserError(f"{what} {folder}: cannot write there ({reason})") from None
     return folder
 
 

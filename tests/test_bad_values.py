@@ -343,3 +343,15 @@ def test_publish_refusal_reads_the_bar_of_the_folder_it_would_replace():
     flags = {"evaluation": {"success_share": 0.6, "episodes": 10}}  # 6 of 10: enough for 1-2, not for 1-1
     assert publish_refusal(mario, Path("saved/mario_ppo/1-2"), flags) is None
     assert "1-1 (success in >= 80% of episodes)" in publish_refusal(mario, Path("saved/mario_ppo/1-1"), flags)
+
+
+def test_a_folder_that_takes_no_new_files_is_said_so_not_missing():
+    """/proc is there, but a file cannot be made in it: the OS says "No such file or directory", which read as
+    if the folder were missing (a new user's `render ... --out /proc/x.mp4`)."""
+    from rlcore.atomic import writable_folder
+    from rlcore.errors import UserError
+
+    if not Path("/proc").is_dir():
+        pytest.skip("no /proc here")
+    with pytest.raises(UserError, match=r"^--out /proc: cannot write there \(the folder takes no new files\)$"):
+        writable_folder("/proc", "--out")
