@@ -7,6 +7,7 @@ TensorFlow-free, so `--help` is quick.
 from __future__ import annotations
 
 import argparse
+import difflib
 import functools
 
 from rlcore import allowed
@@ -14,11 +15,41 @@ from rlcore.allowed import Allowed, whole_number
 from rlcore.seeding import MAX_EVAL_EPISODES, MAX_RUN_SEED
 
 
+def _nearest(flag: str, options) -> list[str]:
+    """The one flag ``flag`` begins (``--epi``: ``--episodes``), else the closest spelling (``--gama``), else none."""
+    starting = [option for option in options if option.startswith(flag)]
+    return starting if len(starting) == 1 else difflib.get_close_matches(flag, list(options), n=1, cutoff=0.75)
+
+
 class _Parser(argparse.ArgumentParser):
-    """argparse that reports a bad command line as one line (and exit status 2)."""
+    """argparse that reports a bad command line as one line (and exit status 2), takes no abbreviated flag
+    (``--epi`` is not ``--episodes``), and answers a flag it does not know in the words of the command it was
+    given to, with the nearest flag that command has."""
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("allow_abbrev", False)
+        super().__init__(*args, **kwargs)
 
     def error(self, message):
-        self.exit(2, f"error: {message} (see `{self.prog} --help`)\n")
+        hint = f"{self.prog} EXPERIMENT ALGO --help" if self.prog.endswith((" train", " sweep")) else f"{self.prog} --help"
+        self.exit(2, f"error: {message} (see `{hint}`)\n")
+
+    def parse_args(self, args=None, namespace=None):
+        known, unknown = self.parse_known_args(args, namespace)
+        if unknown:
+            command = self._command_parser(known)
+            near = [match for flag in unknown if flag.startswith("--") for match in _nearest(flag.split("=")[0],
+                                                                                          command._option_string_actions)]
+            command.error(f"unrecognized arguments: {' '.join(unknown)}"
+                          + (f"; did you mean {', '.join(near)}?" if near else ""))
+        return known
+
+    def _command_parser(self, known) -> argparse.ArgumentParser:
+        """The subcommand's parser (``main.py train``) a namespace was parsed by, else this one."""
+        for action in self._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                return action.choices.get(getattr(known, action.dest, None), self)
+        return self
 
 
 def folder_name(text: str) -> str:

@@ -50,6 +50,10 @@ def dqn_model_dir(tmp_path):
     (["train", "lunar_lander", "dqn3"], "unknown algorithm 'dqn3'"),
     (["train", "lunar_lander", "dqn", "--preset", "fastest"], "unknown preset 'fastest'"),
     (["train", "lunar_lander", "dqn", "--learning-rate", "1"], "unrecognized arguments: --learning-rate"),
+    (["train", "lunar_lander", "dqn", "--gama", "0.9"],
+     "unrecognized arguments: --gama 0.9; did you mean --gamma? (see `main.py train EXPERIMENT ALGO --help`)"),
+    (["evaluate", "cartpole", "a2c", "--epi", "3"],  # no abbreviation is taken for a flag
+     "unrecognized arguments: --epi 3; did you mean --episodes? (see `main.py evaluate --help`)"),
     (["train", "lunar_lander", "dqn", "--lr", "fast"], "invalid float value: 'fast'"),
     (["evaluate", "lunar_lander", "dqn", "--model", "/nonexistent/model"], "/nonexistent/model: no such model folder"),
     (["evaluate", "cartpole", "a2c", "--model", "saved_networks/cartpole/a2c/meta.json"],
