@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import operator
 from dataclasses import dataclass
 
 from rlcore.errors import UserError
@@ -120,7 +121,11 @@ def whole_number(allowed: Allowed):
 def check_whole(name: str, value, allowed: Allowed) -> None:
     """A whole-number argument of the Python API (``seed=``, ``episodes=`` ...), checked as
     :func:`whole_number` checks it on the command line: :class:`UserError` naming it otherwise."""
-    if isinstance(value, bool) or not isinstance(value, int) or not allowed.accepts(value):
+    try:
+        number = None if isinstance(value, bool) else operator.index(value)  # int, numpy integers
+    except TypeError:
+        number = None
+    if number is None or not allowed.accepts(number):
         raise UserError(f"{name}={value!r} is invalid: allowed is {allowed.describe().replace('a number', 'a whole number', 1)}")
 
 

@@ -61,7 +61,8 @@ def _spec_from_args(args):
                   progress=not args.no_progress, command=getattr(args, "command_line", None))
     if args.resume is not None:
         run_dir = latest_run_dir(args.experiment, args.algo) if args.resume == "latest" else Path(args.resume)
-        spec = build_spec(args.experiment, args.algo, run_dir=run_dir, resume=True, **common)
+        spec = build_spec(args.experiment, args.algo, run_dir=run_dir, resume=True,
+                          nothing_to_train_ok=getattr(args, "publish", False), **common)
         from rlcore.checkpoint import read_checkpoint_state
         state = read_checkpoint_state(run_dir / "checkpoint.npz")
         print(f"resuming {run_dir} at episode {len(state['returns'])}, env step {state['env_steps']}"
@@ -77,6 +78,9 @@ def cmd_train(args) -> int:
     from rlcore.trainers.spec import folder_safe
 
     spec = _spec_from_args(args)
+    if args.publish and args.final_eval_episodes is not None and args.final_eval_episodes < spec.experiment.eval_episodes:
+        raise UserError(f"--publish needs the evaluation a shipped model has ({spec.experiment.eval_episodes} episodes "
+                        f"on unseen seeds), not --final-eval-episodes {args.final_eval_episodes}")
     print(f"training {spec.experiment.name} {spec.algo} ({spec.preset} preset, seed {spec.seed}) "
           f"-> {spec.run_dir}")
     model_dir, meta = train_and_evaluate(spec, args.final_eval_episodes)
@@ -350,25 +354,33 @@ def cmd_docs(args) -> int:
 
 
 def _register_recorded_env(model: str | None) -> None:
-    """A model of a user's Gymnasium env, named by its id alone: register the env again from the
-    model's meta.json (its entry point), as the process that trained it had."""
+    """A model (or a run in progress) of a user's Gymnasium env, named by its id alone or as MODULE:ID:
+    register the env as the process that trained it had, by importing its module where the run names
+    one, else from the record's entry point (meta.json's, or the checkpoint's)."""
     if not model:
         return
+    import gymnasium as gym
+
+    from rlcore.checkpoint import read_checkpoint_state
     from rlcore.gym_experiment import register_from_record
 
-    for meta_path in (Path(model) / "meta.json", Path(model) / "model" / "meta.json"):
-        if meta_path.is_file():
-            with contextlib.suppress(ValueError, OSError):
-                meta = json.loads(meta_path.read_text())
-                module = str(meta.get("experiment")).partition(":")[0] if ":" in str(meta.get("experiment")) else None
-                try:  # trained as MODULE:ID: the module registers it, as it did then (once: no second register)
-                    if module:
-                        importlib.import_module(module)
-                        return
-                except ImportError:
-                    pass  # not importable here: the record's entry point may still be
-                register_from_record(meta.get("env") or {})
-            return
+    record = None
+    with contextlib.suppress(ValueError, OSError, UserError):
+        for path in (Path(model) / "meta.json", Path(model) / "model" / "meta.json"):
+            if path.is_file():
+                record = json.loads(path.read_text())
+                break
+        else:  # a run in progress: its checkpoint records the same
+            if (Path(model) / "checkpoint.npz").is_file():
+                record = read_checkpoint_state(Path(model) / "checkpoint.npz")
+    if not record:
+        return
+    module, _, _ = str(record.get("experiment")).rpartition(":")
+    if module:  # trained as MODULE:ID: the module registers it, as it did then (once, not twice)
+        with contextlib.suppress(ImportError):  # not importable here: the record's entry point may be
+            importlib.import_module(module)
+    if (record.get("env") or {}).get("gymnasium_id") not in gym.registry:
+        register_from_record(record.get("env") or {})
 
 
 COMMANDS = {"list": cmd_list, "train": cmd_train, "evaluate": cmd_evaluate, "render": cmd_render,

@@ -31,15 +31,16 @@ class _Parser(argparse.ArgumentParser):
         super().__init__(*args, **kwargs)
 
     def error(self, message):
-        hint = f"{self.prog} EXPERIMENT ALGO --help" if self.prog.endswith((" train", " sweep")) else f"{self.prog} --help"
+        hint = f"{self.prog} EXPERIMENT ALGO --help" if self.prog.endswith(" train") else f"{self.prog} --help"
         self.exit(2, f"error: {message} (see `{hint}`)\n")
 
     def parse_args(self, args=None, namespace=None):
         known, unknown = self.parse_known_args(args, namespace)
         if unknown:
             command = self._command_parser(known)
-            near = [match for flag in unknown if flag.startswith("--") for match in _nearest(flag.split("=")[0],
-                                                                                          command._option_string_actions)]
+            flags = unknown[:unknown.index("--")] if "--" in unknown else unknown  # after --: not flags
+            near = [match for flag in flags if flag.startswith("--")
+                    for match in _nearest(flag.split("=")[0], command._option_string_actions) if match != flag]
             command.error(f"unrecognized arguments: {' '.join(unknown)}"
                           + (f"; did you mean {', '.join(near)}?" if near else ""))
         return known

@@ -85,6 +85,13 @@ def gym_spec(name: str) -> EnvSpec:
         raise UserError(f"{env_id} is not a registered Gymnasium id: {exc}{hint}") from None
 
 
+def names_the_env(given: str | None, recorded: str | None) -> bool:
+    """Whether ``given`` names the env a run recorded: its name, or for a user's ``MODULE:ID`` its id too."""
+    if given is None or given == recorded:
+        return True
+    return isinstance(recorded, str) and ":" in recorded and given == recorded.split(":", 1)[1]
+
+
 def register_from_record(record: dict) -> None:
     """Register a user's env again from a model's meta.json (``env``: id and a string entry point) in a
     process where the module that registered it was not imported. Nothing when the id is known."""

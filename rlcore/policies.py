@@ -44,16 +44,12 @@ def load_policy(model_dir: str | Path, experiment: str | None = None, algo: str 
     (for Mario, its level and action set). ``experiment``/``algo``, when given, must match the
     folder's meta (a DQN folder cannot be rendered as A2C).
     """
+    from rlcore.gym_experiment import names_the_env
+
     meta = read_meta(model_dir)
-    for key, wanted in (("experiment", experiment), ("algo", algo)):
-        recorded = meta.get(key)
-        if key == "experiment" and isinstance(recorded, str) and ":" in recorded:
-            recorded_as = {recorded, recorded.split(":", 1)[1]}  # a user's MODULE:ID env, named by its id too
-        else:
-            recorded_as = {recorded}
-        if wanted is not None and wanted not in recorded_as:
-            raise UserError(f"model in {model_dir} is {meta.get('experiment')} {meta.get('algo')}, "
-                            f"not {experiment} {algo}")
+    if not (names_the_env(experiment, meta.get("experiment")) and algo in (None, meta.get("algo"))):
+        raise UserError(f"model in {model_dir} is {meta.get('experiment')} {meta.get('algo')}, "
+                        f"not {experiment} {algo}")
     exp = get_experiment(meta["experiment"], meta.get("env"))
     spec = exp.algo(meta["algo"])
     if spec.kind not in POLICY_FILES:

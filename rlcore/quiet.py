@@ -33,8 +33,8 @@ NOISE = re.compile("|".join([
 # SDL (pygame, which Gymnasium's classic-control and Box2D envs draw their frames with) starts a video
 # driver and, on a machine without a display, prints "error: XDG_RUNTIME_DIR is invalid or not set": there
 # no window can open anyway, and frames for a video need none, so SDL gets its dummy driver
-if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
-    os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+    os.environ.setdefault("SDL_VIDEODRIVER", "dummy")  # (macOS and Windows have displays without DISPLAY)
 
 
 def keep(line: str) -> bool:

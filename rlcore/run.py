@@ -25,9 +25,11 @@ from rlcore.trainers.spec import RunSpec, check_resumable
 
 def build_spec(experiment: str, algo: str, *, preset: str | None = None, seed: int | None = None,
                overrides: dict | None = None, run_dir: Path, resume: bool = False,
-               wandb_mode: str = "auto", progress: bool = True, command: str | None = None) -> RunSpec:
+               wandb_mode: str = "auto", progress: bool = True, command: str | None = None,
+               nothing_to_train_ok: bool = False) -> RunSpec:
     """The :class:`RunSpec` of a new run (``resume=False``; ``seed`` None = 0) or of the run in
-    ``run_dir``, whose seed, preset and defining fields a resume may not change."""
+    ``run_dir``, whose seed, preset and defining fields a resume may not change, and which must have
+    something left to train unless ``nothing_to_train_ok`` (``--publish``: evaluate it again, publish)."""
     exp = get_experiment(experiment)
     overrides = dict(overrides or {})
     extra = {} if command is None else {"command": command}
@@ -51,12 +53,44 @@ def build_spec(experiment: str, algo: str, *, preset: str | None = None, seed: i
             raise UserError(f"--seed {seed} cannot change on --resume: the run in {run_dir} has seed "
                             f"{state['seed']}")
         spec.preset, spec.seed = state["preset"], state["seed"]
+        if not nothing_to_train_ok:
+            refuse_nothing_to_train(spec, state)
         return spec
     config = apply_overrides(exp.preset(algo, preset), overrides)
     check_no_inert(config, overrides)
     seed = 0 if seed is None else seed
     return RunSpec(exp, algo, preset or exp.algo(algo).default_preset, config, seed, wandb_mode,
                    Path(run_dir), progress=progress, **extra)
+
+
+def refuse_nothing_to_train(spec: RunSpec, state: dict) -> None:
+    """A finished run whose model holds its last checkpoint, resumed with the rule that ended it still
+    met (the same or a smaller budget, an unchanged goal), would train nothing and only evaluate again:
+    one line, before any agent, env or file is touched. A run whose model is missing or older than its
+    checkpoint (stopped between the two) goes on to write it."""
+    import json
+
+    from rlcore.allowed import flag
+    from rlcore.trainers.episodes import EpisodeBook
+    from rlcore.trainers.periodic_eval import PeriodicEvaluation
+    from rlcore.trainers.stopping import StopRules
+
+    try:
+        meta = json.loads((spec.run_dir / "model" / "meta.json").read_text())
+    except (OSError, ValueError):
+        return
+    episodes, env_steps = len(state.get("returns") or []), int(state.get("env_steps", 0))
+    if (meta.get("episodes"), meta.get("env_steps")) != (episodes, env_steps):
+        return
+    cfg = spec.config
+    book = EpisodeBook(cfg.window, spec.experiment.solved_score, state.get("returns"), state.get("successes"),
+                       state.get("counted_returns"))
+    ended = StopRules(cfg).reason(book, env_steps, PeriodicEvaluation(cfg, state))
+    if ended:
+        field, _, value = ended.partition(" ")
+        raise UserError(f"nothing to train: the run in {spec.run_dir} is finished, and what ended it still holds "
+                        f"({flag(field)} {value}, at episode {episodes:,}, env step {env_steps:,}); give a larger "
+                        f"budget (--episodes or --steps) or change that setting")
 
 
 def run_training(spec: RunSpec, on_progress: Callable[[dict, str], None] | None = None) -> Path:

@@ -214,6 +214,9 @@ def publish_refusal(experiment, target: Path, meta: dict) -> str | None:
     evaluation = meta.get("evaluation")
     if not evaluation:
         return "it has no evaluation on unseen seeds (it was trained with --final-eval-episodes 0)"
+    if (evaluation.get("episodes") or 0) < experiment.eval_episodes:  # a bar met on one lucky episode is not met
+        return (f"its evaluation has {evaluation.get('episodes') or 0} episodes; a shipped model's has "
+                f"{experiment.eval_episodes}")
     bar = experiment.bar(target.name)
     if bar is not None and not bar.met_by(evaluation):
         return f"its evaluation misses the bar of the shipped {target.name} ({bar.describe()})"

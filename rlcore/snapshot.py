@@ -41,7 +41,9 @@ def model_from_checkpoint(run_dir: str | Path, out_dir: str | Path, experiment: 
     the meta. The run must be one of ``experiment`` ``algo``."""
     run_dir, out_dir = Path(run_dir), Path(out_dir)
     state = read_checkpoint_state(run_dir / CHECKPOINT_FILE)
-    if (state.get("experiment"), state.get("algo")) != (experiment, algo):
+    from rlcore.gym_experiment import names_the_env
+
+    if not (names_the_env(experiment, state.get("experiment")) and state.get("algo") == algo):
         raise UserError(f"the run in {run_dir} is {state.get('experiment')} {state.get('algo')}, "
                         f"not {experiment} {algo}")
     exp = get_experiment(state["experiment"], state.get("env"))

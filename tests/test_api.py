@@ -56,6 +56,10 @@ def test_load_mistakes_are_user_errors(model, message):
     ({"steps": True}, "steps=True is invalid"),
 ])
 def test_train_checks_its_arguments_as_the_command_line_does_before_any_folder_exists(tmp_path, kwargs, message):
+    from rlcore.allowed import check_whole
+    from rlcore.command_line import RUN_SEEDS
+
+    check_whole("seed", np.int64(3), RUN_SEEDS)  # numpy's integers are whole numbers too
     with pytest.raises(UserError, match=message):
         api.train("cartpole", "dqn", run_dir=tmp_path / "run", **{"episodes": 2, **kwargs})
     assert not (tmp_path / "run").exists()

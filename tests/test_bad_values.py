@@ -213,7 +213,8 @@ NOISE = ("oneDNN", "cuInit", "cuda", "absl", "argv[0]", "pybullet build time", "
 def _cli(*argv, cwd):
     # as on a machine without a display, where SDL complained (a user's `render cartpole a2c`)
     env = {k: v for k, v in os.environ.items()
-           if k not in ("TF_CPP_MIN_LOG_LEVEL", "WANDB_SILENT", "DISPLAY", "WAYLAND_DISPLAY", "SDL_VIDEODRIVER")}
+           if k not in ("TF_CPP_MIN_LOG_LEVEL", "WANDB_SILENT", "DISPLAY", "WAYLAND_DISPLAY", "SDL_VIDEODRIVER",
+                        "XDG_RUNTIME_DIR")}
     done = subprocess.run([sys.executable, str(ROOT / "main.py"), *argv], cwd=cwd, env=env,
                           capture_output=True, text=True, timeout=300)
     return done.returncode, done.stdout + done.stderr
@@ -324,6 +325,11 @@ def test_publish_refuses_a_model_that_misses_the_bar_of_the_one_it_would_replace
     run_dir = tmp_path / "run"
     code, out, err = run(capsys, "train", "cartpole", "dqn", "--episodes", "3", "--final-eval-episodes", "2",
                          "--wandb", "off", "--no-progress", "--run-dir", str(run_dir), "--publish")
+    assert code == 2 and not run_dir.exists(), (out, err)  # refused before training: a bar met on 2 episodes is luck
+    assert err.strip() == ("error: --publish needs the evaluation a shipped model has (100 episodes on unseen seeds), "
+                           "not --final-eval-episodes 2")
+    code, out, err = run(capsys, "train", "cartpole", "dqn", "--episodes", "3", "--wandb", "off", "--no-progress",
+                         "--run-dir", str(run_dir), "--publish")
     assert code == 2, (out, err)
     assert err.strip() == (f"error: not published to {shipped}/: its evaluation misses the bar of the shipped dqn "
                            f"(mean return >= 500); the model stays in {run_dir / 'model'}/")
@@ -336,10 +342,12 @@ def test_publish_refusal_reads_the_bar_of_the_folder_it_would_replace():
     from rlcore.shipping import publish_refusal
 
     lander, mario = get_experiment("lunar_lander"), get_experiment("mario_ppo")
-    assert publish_refusal(lander, Path("saved/lunar_lander/dqn"), {"evaluation": {"mean": 231.0}}) is None
+    assert publish_refusal(lander, Path("saved/lunar_lander/dqn"), {"evaluation": {"mean": 231.0, "episodes": 100}}) is None
     assert "misses the bar of the shipped a2c (mean return >= 200)" in publish_refusal(
-        lander, Path("saved/lunar_lander/a2c"), {"evaluation": {"mean": 199.0}})
+        lander, Path("saved/lunar_lander/a2c"), {"evaluation": {"mean": 199.0, "episodes": 100}})
     assert "no evaluation on unseen seeds" in publish_refusal(lander, Path("saved/lunar_lander/dqn"), {})
+    assert "its evaluation has 1 episodes; a shipped model's has 10" in publish_refusal(
+        mario, Path("saved/mario_ppo/1-2"), {"evaluation": {"success_share": 1.0, "episodes": 1}})
     flags = {"evaluation": {"success_share": 0.6, "episodes": 10}}  # 6 of 10: enough for 1-2, not for 1-1
     assert publish_refusal(mario, Path("saved/mario_ppo/1-2"), flags) is None
     assert "1-1 (success in >= 80% of episodes)" in publish_refusal(mario, Path("saved/mario_ppo/1-1"), flags)

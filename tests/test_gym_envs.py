@@ -195,3 +195,12 @@ def test_every_hyperparameter_is_a_flag_and_checked(capsys):
     assert code == 2 and "--gamma" in err and err.count("\n") == 1
     with pytest.raises(UserError, match="unknown hyperparameter"):
         api.train("Acrobot-v1", "dqn", learning_rate=1e-3)
+
+
+def test_a_user_env_run_is_named_as_trained_or_by_its_id():
+    from rlcore.gym_experiment import names_the_env
+
+    assert names_the_env("tests.user_env:Chase-v0", "tests.user_env:Chase-v0")
+    assert names_the_env("Chase-v0", "tests.user_env:Chase-v0") and names_the_env(None, "lunar_lander")
+    assert not names_the_env("Chase-v1", "tests.user_env:Chase-v0") and not names_the_env("Chase-v0", "Chase-v1")
+    assert not names_the_env("user_env:Chase-v0", "tests.user_env:Chase-v0")

@@ -132,4 +132,12 @@ def test_a_finished_run_resumed_with_nothing_left_to_train_is_refused_and_left_a
     code, out, err = run(capsys, "train", "cartpole", "dqn", "--resume", str(run_dir), "--episodes", "4",
                          "--final-eval-episodes", "1", "--wandb", "off", "--no-progress")
     assert code == 0, err
-    assert json.loads((run_dir / "model" / "meta.json").read_text())["episodes"] == 4
+    meta_path = run_dir / "model" / "meta.json"
+    assert json.loads(meta_path.read_text())["episodes"] == 4
+    # stopped between its last checkpoint and its model (the model older than the checkpoint): it goes on
+    meta = json.loads(meta_path.read_text())
+    meta_path.write_text(json.dumps({**meta, "episodes": 3}))
+    code, out, err = run(capsys, "train", "cartpole", "dqn", "--resume", str(run_dir), "--final-eval-episodes", "1",
+                         "--wandb", "off", "--no-progress")
+    assert code == 0, err
+    assert json.loads(meta_path.read_text())["episodes"] == 4

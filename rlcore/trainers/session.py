@@ -65,8 +65,6 @@ class TrainingSession:
         self.evaluation.restore_best_arrays(resumed_arrays or {})
         self.stop = StopRequest(spec.stop_file)
         self.rules = StopRules(cfg)
-        if resumed_state:
-            self._refuse_a_resume_with_nothing_to_train()
         self.stop_reason: str | None = None
         self.tracker = Tracker(self.run_dir, self.run_dir.name, spec.describe(), spec.wandb_mode,
                                on_row=spec.on_progress, wandb_id=state.get("wandb_id"))
@@ -76,20 +74,6 @@ class TrainingSession:
                 print("resume: dropped rows logged after the checkpoint ("
                       + ", ".join(f"{n} from {name}" for name, n in dropped.items()) + ")", file=sys.stderr)
         self.progress = Progress(progress_unit, cfg, self.book.episodes, self.env_steps, spec.progress)
-
-    def _refuse_a_resume_with_nothing_to_train(self) -> None:
-        """A finished run (its model written) resumed with the rule that ended it still met (the same or a
-        smaller budget, an unchanged goal) would train nothing and only evaluate again: refused in one line,
-        before any file is touched. A run that ended before writing its model goes on to write it."""
-        ended = self.rules.reason(self.book, self.env_steps, self.evaluation)
-        if ended and (self.run_dir / "model" / "meta.json").is_file():
-            from rlcore.allowed import flag
-            from rlcore.errors import UserError
-
-            field, _, value = ended.partition(" ")
-            raise UserError(f"nothing to train: the run in {self.run_dir} is finished, and what ended it still holds "
-                            f"({flag(field)} {value}, at episode {self.book.episodes:,}, env step {self.env_steps:,}); "
-                            f"give a larger budget (--episodes or --steps) or change that setting")
 
     # ------------------------------------------------------------ the loop's calls
     def fresh_env_seeds(self, n: int) -> list[int]:
