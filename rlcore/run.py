@@ -109,8 +109,9 @@ def run_training(spec: RunSpec, on_progress: Callable[[dict, str], None] | None 
 
 #: what the end of a run imports inside its functions: its model, the final evaluation, meta.json, the
 #: video of ``--video`` (rlcore.api's render)
-END_OF_RUN_MODULES = ("rlcore.api", "rlcore.atomic", "rlcore.evaluation", "rlcore.machine", "rlcore.models",
-                      "rlcore.plotting", "rlcore.policies", "rlcore.shipping", "rlcore.snapshot", "rlcore.video")
+END_OF_RUN_MODULES = ("rlcore.api", "rlcore.atomic", "rlcore.evaluation", "rlcore.gym_experiment", "rlcore.machine",
+                      "rlcore.models", "rlcore.plotting", "rlcore.policies", "rlcore.shipping", "rlcore.snapshot",
+                      "rlcore.video")
 
 
 def _import_the_end_of_a_run() -> None:

@@ -104,7 +104,7 @@ def test_export_of_a_missing_model_folder_is_one_line(tmp_path, capsys):
     code = main.main(["export", "lunar_lander", "dqn", "--model", str(tmp_path / "nowhere"),
                       "--format", "onnx", "--out", str(tmp_path / "out")])
     err = capsys.readouterr().err.strip()
-    assert code == 2 and err.startswith("error: ") and "\n" not in err and "meta.json" in err
+    assert code == 2 and err == f"error: {tmp_path / 'nowhere'}: no such model folder"
     assert not (tmp_path / "out").exists()
 
 
