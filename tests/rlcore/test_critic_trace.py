@@ -33,7 +33,7 @@ def test_episodes_before_the_first_gradient_step_are_left_out_and_the_largest_re
     trace = critic_trace(_metrics(tmp_path / "run", returns, qs))
     assert trace.env_steps.tolist() == [100.0 * i for i in range(3, 43)]
     assert trace.q_end == pytest.approx(np.median(np.array(qs[-20:], dtype=float)))
-    assert trace.largest_return == 9.5  # an episode before learning started still paid its return
+    assert trace.largest_return == pytest.approx(9.5)  # an episode before learning started still paid its return
     assert critic_cell(trace) == f"{trace.q_end:.2f} (largest return 9.50)"
 
 
@@ -81,7 +81,7 @@ def test_rows_without_env_steps_are_skipped_and_a_run_without_returns_says_so(tm
     run_dir.mkdir()
     (run_dir / "metrics.csv").write_text("episode,env_steps,q_mean\n1,100,12.25\n2,,40.0\n3,300,14.75\n")
     trace = critic_trace(run_dir)
-    assert trace.env_steps.tolist() == [100.0, 300.0] and trace.q_end == 13.5
+    assert trace.env_steps.tolist() == [100.0, 300.0] and trace.q_end == pytest.approx(13.5)
     assert critic_cell(trace) == "13.5 (largest return –)"  # a value from 10 to 100: one decimal
 
 

@@ -80,7 +80,9 @@ def test_a_resume_differs_from_the_run_that_never_stopped_only_in_its_envs_episo
     TRAINERS[algo].train(resumed)
     a, b = (pd.read_csv(spec.run_dir / "metrics.csv").drop(columns="wall_seconds") for spec in (never_stopped, resumed))
     assert len(a) == len(b) == 30
-    pd.testing.assert_frame_equal(a, b, check_exact=True)
+    # equal to a tolerance far below what a different episode or an unrestored RNG moves (both runs are
+    # computed here, but no float read back from a file is held to the bit)
+    pd.testing.assert_frame_equal(a, b, check_exact=False, rtol=1e-6, atol=1e-9)
 
 
 def _watch_sac_temperature(monkeypatch) -> list[float]:
