@@ -111,34 +111,49 @@ NO_BUDGET = 10**9
 def pace(metrics_csv: Path, about: dict, span_seconds: float = 1800.0) -> tuple[float, float | None] | None:
     """A run in progress: its env steps per second over the last ``span_seconds`` of its training clock
     (``metrics.csv``'s ``wall_seconds``, which a resume carries on), and the seconds left at that pace to
-    its env-step budget (None without one), at most: a stop rule may end it sooner. None for a table
-    without that clock."""
+    its env-step budget (None without one, or while it takes no gradient step yet: an off-policy run's
+    first, random steps run about twice as fast as its learning ones, so they tell nothing of the hours
+    left). A stop rule may end it sooner, a slower pace later. None for a table without that clock."""
     if not Path(metrics_csv).is_file():
         return None
     df = read_table(metrics_csv, "env_steps")
     if "wall_seconds" not in df:
         return None
+    learning = df["grad_steps"].fillna(0) > 0 if "grad_steps" in df else None
     df = df[["env_steps", "wall_seconds"]].dropna()
     # only the rows since either counter last went back (a table pieced together from two runs)
     back = ((df["wall_seconds"].diff() < 0) | (df["env_steps"].diff() < 0)).to_numpy().nonzero()[0]
     df = df.iloc[back[-1]:] if len(back) else df
-    if len(df) < 2:
+    if learning is not None:  # from the last row before its first gradient step (when it began to learn)
+        learning = learning.reindex(df.index)
+        if not learning.any():
+            measured = _rate(df, span_seconds)
+            return None if measured is None else (measured, None)
+        first = learning.to_numpy().nonzero()[0][0]
+        df = df.iloc[max(0, first - 1):]
+    rate = _rate(df, span_seconds)
+    if rate is None:
         return None
-    recent = df[df["wall_seconds"] >= df["wall_seconds"].iloc[-1] - span_seconds]
-    recent = recent if len(recent) >= 2 else df.tail(2)
-    seconds = float(recent["wall_seconds"].iloc[-1] - recent["wall_seconds"].iloc[0])
-    steps = float(recent["env_steps"].iloc[-1] - recent["env_steps"].iloc[0])
-    if not (seconds > 0 and steps > 0):
-        return None
-    rate = steps / seconds
     budget = (about.get("config") or {}).get("max_env_steps")
     done = about.get("env_steps", int(df["env_steps"].iloc[-1]))
     left = max(0, budget - done) / rate if budget and budget < NO_BUDGET else None
     return rate, left
 
 
+def _rate(df: pd.DataFrame, span_seconds: float) -> float | None:
+    """Env steps per second over the last ``span_seconds`` of the ``wall_seconds`` clock (the last two rows
+    when fewer fall in it); None for fewer than two rows or no time or step between them."""
+    if len(df) < 2:
+        return None
+    recent = df[df["wall_seconds"] >= df["wall_seconds"].iloc[-1] - span_seconds]
+    recent = recent if len(recent) >= 2 else df.tail(2)
+    seconds = float(recent["wall_seconds"].iloc[-1] - recent["wall_seconds"].iloc[0])
+    steps = float(recent["env_steps"].iloc[-1] - recent["env_steps"].iloc[0])
+    return steps / seconds if seconds > 0 and steps > 0 else None
+
+
 def pace_text(metrics_csv: Path, about: dict, measured: tuple[float, float | None] | None = None) -> str | None:
-    """:func:`pace` in words: ``86 env steps/s lately, at most 3.1 h to its budget of 1,000,000 env steps``
+    """:func:`pace` in words: ``86 env steps/s lately, about 3.1 h to its budget of 1,000,000 env steps``
     (``measured``: what :func:`pace` gave already, so the table is not read again)."""
     measured = measured or pace(metrics_csv, about)
     if measured is None:
@@ -146,7 +161,7 @@ def pace_text(metrics_csv: Path, about: dict, measured: tuple[float, float | Non
     rate, left = measured
     text = (f"{rate:,.0f}" if rate >= 10 else f"{rate:.2g}") + " env steps/s lately"
     if left:
-        text += f", at most {left / 3600:.1f} h to its budget of {about['config']['max_env_steps']:,} env steps"
+        text += f", about {left / 3600:.1f} h to its budget of {about['config']['max_env_steps']:,} env steps"
     return text
 
 

@@ -66,9 +66,9 @@ def sweep_status(folder: str | Path) -> list[str]:
 
 
 def time_left(left: list, rates: list[float], budget: int | None, at_once: int) -> list[str]:
-    """The sweep's hours of training left, at most: each running trial's to its env-step budget at its
+    """The sweep's hours of training left, about: each running trial's to its env-step budget at its
     pace lately, each trial not started over its whole budget at the finished trials' mean pace (a stop
-    rule may end any sooner), ``at_once`` trials at a time (0: as many as the CPUs allow, unknown here,
+    rule may end any sooner, a slower pace later), ``at_once`` trials at a time (0: as many as the CPUs allow, unknown here,
     so the sum is given), and never less than the longest trial's own. ``budget``: the trials' env-step
     budget as their records hold it. No line when a part cannot be told."""
     waiting = left.count(NOT_STARTED)
@@ -83,4 +83,4 @@ def time_left(left: list, rates: list[float], budget: int | None, at_once: int) 
     shared = f", {at_once} trial{'s' * (at_once > 1)} at a time" if at_once else " in all (trials at once not fixed)"
     waiting_text = (f" ({waiting} trial{'s' * (waiting > 1)} not started, at the finished trials' mean pace)"
                     if waiting else "")
-    return [f"at most about {seconds / 3600:.1f} h of training left{shared}, at the paces seen{waiting_text}"]
+    return [f"about {seconds / 3600:.1f} h of training left{shared}, at the paces seen{waiting_text}"]

@@ -349,12 +349,12 @@ def test_status_of_a_sweep_folder_is_a_line_per_trial(tmp_path, capsys):
     assert out.splitlines() == [
         "sweep st: toy dqn, 3 trials",
         "  seed=0: finished at 1,200 env steps, final score 9.50 on unseen seeds",
-        "  seed=1: checkpoint at 700 env steps, 2.0 h, 0.4 env steps/s lately, at most 2.5 h to its budget of 4,300 "
+        "  seed=1: checkpoint at 700 env steps, 2.0 h, 0.4 env steps/s lately, about 2.5 h to its budget of 4,300 "
         "env steps; last evaluation at env step 500: mean 3.25 +- 0.50, 40% of its episodes to the time limit; "
         "critic: mean Q 2.50 (largest return 0.50)",  # the median of the episodes that made gradient steps
         "  seed=2: not started",
         # seed 1: 3,600 env steps at 0.4/s = 2.5 h; seed 2: 4,300 at seed 0's 20 env steps/s = 0.06 h
-        "at most about 2.6 h of training left, 1 trial at a time, at the paces seen (1 trial not started, at the "
+        "about 2.6 h of training left, 1 trial at a time, at the paces seen (1 trial not started, at the "
         "finished trials' mean pace)"]
     (running / "metrics.csv").write_bytes(b"\x00\xff damaged")  # one trial's damaged table: its line says less
     code, out, err = run(capsys, "status", str(tmp_path / "st"))

@@ -64,7 +64,7 @@ def test_status_of_a_run_in_progress_gives_its_pace_and_the_hours_left_to_its_bu
         "config": {"window": 10, "max_env_steps": 9_200_000}, "env_steps": 2_000_000, "returns": [0.5] * 3,
         "wall_seconds": 3600.0})
     assert status_lines(capsys, tmp_path)[0].endswith(
-        "1.0 h of training; 1,000 env steps/s lately, at most 2.0 h to its budget of 9,200,000 env steps")
+        "1.0 h of training; 1,000 env steps/s lately, about 2.0 h to its budget of 9,200,000 env steps")
 
 
 def test_status_of_a_run_resumed_many_times_names_the_first_and_latest_resumes():
@@ -91,6 +91,21 @@ def test_pace_reads_only_the_rows_since_a_counter_went_back_and_never_says_nan(t
     assert pace(table, about) is None
 
 
+def test_the_hours_left_are_read_from_the_pace_of_learning_not_of_the_random_first_steps(tmp_path):
+    from rlcore.status import pace
+
+    about = {"env_steps": 4000, "config": {"max_env_steps": 10_000}}
+    table = tmp_path / "metrics.csv"
+    # 200 env steps a second before the first gradient step, 100 since: 6,000 left at 100 a second
+    table.write_text("episode,env_steps,wall_seconds,grad_steps\n1,1000,5,0\n2,2000,10,0\n3,3000,20,1000\n"
+                     "4,4000,30,2000\n")
+    assert pace(table, about) == pytest.approx((100.0, 60.0))
+    table.write_text("episode,env_steps,wall_seconds,grad_steps\n1,1000,5,0\n2,2000,10,0\n")  # none yet
+    assert pace(table, about) == pytest.approx((200.0, None))
+    table.write_text("episode,env_steps,wall_seconds,grad_steps\n1,1000,10,5\n2,2000,20,10\n")  # from the start
+    assert pace(table, about) == pytest.approx((100.0, 60.0))
+
+
 def test_a_finished_run_resumed_past_its_model_is_read_from_its_checkpoint(tmp_path):
     import json
 
@@ -109,14 +124,14 @@ def test_a_finished_run_resumed_past_its_model_is_read_from_its_checkpoint(tmp_p
 def test_the_sweeps_hours_left_are_never_fewer_than_its_longest_trials():
     from rlcore.sweep_status import NOT_STARTED, time_left
 
-    assert time_left([3600.0], [], None, 4) == ["at most about 1.0 h of training left, 4 trials at a time, at the "
+    assert time_left([3600.0], [], None, 4) == ["about 1.0 h of training left, 4 trials at a time, at the "
                                                 "paces seen"]
     # two running (1 h, 2 h) and two waiting (1,000 env steps at 1 a second), two at a time: 1.8 h shared
     # out, but the 2-hour trial alone takes 2 h
     assert time_left([3600.0, 7200.0, NOT_STARTED, NOT_STARTED], [0.5, 1.5], 1000, 2)[0].startswith(
-        "at most about 2.0 h of training left, 2 trials at a time")
+        "about 2.0 h of training left, 2 trials at a time")
     # four trials of an hour each, two at a time: 2 h
     assert time_left([3600.0, 3600.0, NOT_STARTED, NOT_STARTED], [1.0], 3600, 2)[0].startswith(
-        "at most about 2.0 h of training left, 2 trials at a time, at the paces seen (2 trials not started")
+        "about 2.0 h of training left, 2 trials at a time, at the paces seen (2 trials not started")
     assert time_left([None, 3600.0], [], None, 1) == []  # a trial whose pace cannot be told
     assert time_left([NOT_STARTED], [], 1000, 1) == []  # no finished trial to take a pace from
