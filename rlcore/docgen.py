@@ -23,6 +23,7 @@ import sys
 from rlcore.docgen_data import (ENV_IDS, GENERATED_NOTE, GIFS, REPO, Model, Sweep,  # noqa: F401 (used by the
                                 kept_sweeps, read_json, shipped_models)              # other docgen modules too)
 from rlcore.experiment import get_experiment, experiment_names
+from rlcore.score_words import score_words
 
 #: the docs page of each experiment (cartpole_v0 shares CartPole's page)
 EXPERIMENT_PAGES = {"lunar_lander": "lunar_lander", "cartpole": "cartpole", "cartpole_v0": "cartpole",
@@ -52,19 +53,9 @@ def score_value(model: Model) -> float | None:
 
 def score_text(model: Model) -> str:
     """``270.7 ± 21.4`` or ``flag in 8 of 10``: the shipped score on unseen seeds."""
-    ev = model.evaluation
-    if not ev:
+    if not model.evaluation:
         return "not evaluated"
-    if "success_share" in ev:
-        won = round(ev["success_share"] * ev["episodes"])
-        return f"{_success_word(model)} in {won} of {ev['episodes']}"
-    digits = 1 if abs(ev["mean"]) >= 100 else 2  # 270.7 ± 21.4, but 20.45 ± 3.99
-    return f"{num(ev['mean'], digits)} ± {num(ev['std'], digits)}"
-
-
-def _success_word(model: Model) -> str:
-    # the castles (x-4) end at an axe, not a flag
-    return "axe" if model.experiment == "mario_ppo" and model.name.endswith("-4") else "flag"
+    return score_words(model.evaluation, model.experiment, model.name)
 
 
 def policy_text(model: Model) -> str:

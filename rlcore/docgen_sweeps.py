@@ -129,11 +129,11 @@ def _hours(seconds: float) -> str:
 def evaluation_cell(evaluation: dict, m) -> str:
     """``flag in 9 of 10`` (Mario), ``18.6 over 30``, and where the bar asks for episodes that last to the
     time limit, ``18.6 over 30 (93% full length)``: one recorded evaluation, as the card writes it."""
-    from rlcore.docgen import _success_word, num
+    from rlcore.docgen import num
+    from rlcore.score_words import score_words
 
     if "success_share" in evaluation:
-        won = round(evaluation["success_share"] * evaluation["episodes"])
-        return f"{_success_word(m)} in {won} of {evaluation['episodes']}"
+        return score_words(evaluation, m.experiment, m.name)
     text = f"{num(evaluation['mean'])} over {evaluation['episodes']}"
     share = evaluation.get("time_limit_share")
     if share is not None and m.bar is not None and m.bar.full_length_share is not None:
@@ -144,7 +144,8 @@ def evaluation_cell(evaluation: dict, m) -> str:
 def stop_text(meta: dict, m) -> str:
     """What ended a run, in words (meta.json's ``stopped_by`` names the rule and its value: ``max_env_steps
     1000000`` -> ``its budget of 1,000,000 env steps``); a rule not known here, as recorded."""
-    from rlcore.docgen import _success_word, num
+    from rlcore.docgen import num
+    from rlcore.score_words import success_word
 
     recorded = meta.get("stopped_by") or ""
     rule, _, value = recorded.partition(" ")
@@ -157,7 +158,7 @@ def stop_text(meta: dict, m) -> str:
              "max_episodes": f"its budget of {number:,.0f} episodes",
              "stop_eval_score": f"a periodic evaluation of {num(number)} or more",
              "stop_score": f"a {window}-episode average of {num(number)} or more",
-             "stop_success_share": f"reached the {_success_word(m)} in {number * 100:g}% or more of the last {window} "
+             "stop_success_share": f"reached the {success_word(m.experiment, m.name)} in {number * 100:g}% or more of the last {window} "
                                    f"training episodes from the start"}
     return texts.get(rule, recorded)
 

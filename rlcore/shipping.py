@@ -60,14 +60,18 @@ def shipped_dir(experiment: str, algo: str, config=None) -> Path:
 
 
 def shipped_summary(folder: Path) -> str:
+    """``shipped: 20.45 +- 3.99 over 30 episodes`` or ``1-1: flag in 8 of 10 episodes``, as the README
+    writes the score (:mod:`rlcore.score_words`)."""
     from rlcore.policies import read_meta
+    from rlcore.score_words import score_words
 
     ev = read_meta(folder).get("evaluation")
     if not ev:
         return f"{folder.name}: shipped (not evaluated)"
+    words = score_words(ev, folder.parent.name, folder.name, plus_minus="+-")
     if "success_share" in ev:
-        return f"{folder.name}: success in {ev['success_share']:.0%} of {ev['episodes']} episodes"
-    return f"shipped: {ev['mean']:.1f} +- {ev['std']:.1f} over {ev['episodes']} episodes"
+        return f"{folder.name}: {words} episodes"
+    return f"shipped: {words} over {ev['episodes']} episodes"
 
 
 def eval_episodes(exp, requested: int | None) -> int:

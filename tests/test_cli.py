@@ -180,6 +180,30 @@ def test_list_and_help(capsys):
     assert code == 0 and "--tau FLOAT" in out and "--updates-per-call" in out
 
 
+def test_list_writes_each_shipped_score_as_the_readme_does(capsys):
+    """`list` and the README's results table read the same meta.json: the same words and digits."""
+    from rlcore.docgen import score_text
+    from rlcore.docgen_data import shipped_models
+
+    code, out, _ = run(capsys, "list")
+    readme = (Path(main.__file__).parent / "README.md").read_text()
+    models = [m for m in shipped_models() if m.evaluation]
+    assert models
+    for m in models:
+        words = score_text(m)
+        assert f"**{words}**" in readme
+        assert words.replace("±", "+-") in out, (m.slug, words)
+
+
+def test_score_words_give_two_decimals_below_100_and_a_castles_axe():
+    from rlcore.score_words import score_words
+
+    assert score_words({"mean": 20.4512, "std": 3.987}, "minitaur", "sac") == "20.45 ± 3.99"
+    assert score_words({"mean": 270.71, "std": 21.44}, "lunar_lander", "dqn", "+-") == "270.7 +- 21.4"
+    assert score_words({"success_share": 0.8, "episodes": 10}, "mario_ppo", "1-4") == "axe in 8 of 10"
+    assert score_words({"success_share": 0.5, "episodes": 30}, "mario_ppo", "1-1") == "flag in 15 of 30"
+
+
 @pytest.mark.parametrize("argv", [[], *([name] for name in main.COMMANDS)])
 def test_every_help_page_prints(capsys, argv):
     """`main.py --help` and each command's --help: exit 0 and a usage line, never a traceback."""
