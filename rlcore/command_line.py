@@ -128,7 +128,8 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
                                     "actions) or sac (continuous actions)")
     train.add_argument("--preset", default=None, help=PRESET_HELP)
     train.add_argument("--episodes", type=COUNT, default=None, help="episode budget (max_episodes)")
-    train.add_argument("--steps", type=COUNT, default=None, help="env step budget (max_env_steps)")
+    train.add_argument("--steps", type=COUNT, default=None, help="env step budget (max_env_steps), checked at the end of each episode (DQN, SAC) "
+                       "or rollout (A2C, PPO: n_steps x num_envs env steps): a run ends at it or just past it")
     train.add_argument("--seed", type=SEED, default=None,
                        help=f"0 to {MAX_RUN_SEED}: seeds numpy, TensorFlow and the envs (default 0); each run "
                             "seed owns its own training env seeds, all below the evaluation seeds")
@@ -199,7 +200,8 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
                        help="a hyperparameter and its values (repeatable), e.g. --grid lr=1e-4,3e-4")
     sweep.add_argument("--preset", default=None, help=PRESET_HELP)
     sweep.add_argument("--episodes", type=COUNT, default=None, help="episode budget of each run")
-    sweep.add_argument("--steps", type=COUNT, default=None, help="env step budget of each run")
+    sweep.add_argument("--steps", type=COUNT, default=None, help="env step budget of each run (as train's --steps: it ends at the end of the "
+                       "episode or rollout that reaches it)")
     sweep.add_argument("--final-eval-episodes", type=FINAL_EVAL_EPISODES, default=None,
                        help="evaluation episodes on unseen seeds after each run (default 100; Mario 10)")
     sweep.add_argument("--max-concurrent", type=NON_NEGATIVE, default=0,
