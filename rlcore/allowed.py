@@ -5,13 +5,19 @@
 ``check_fields(cfg)`` runs every declaration when a config is built (its ``__post_init__``), so a
 bad value from the command line, a preset or a checkpoint is refused before any run folder exists,
 with one line naming the flag, the value and what is allowed. TensorFlow-free.
+
+The line names a setting as its caller wrote it: ``--lr -1.0`` on the command line, ``lr=-1.0`` inside
+:func:`python_names` (the Python API's calls).
 """
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import dataclasses
 import math
 import operator
 from dataclasses import dataclass
+from typing import Iterator
 
 from rlcore.errors import UserError
 
@@ -73,8 +79,34 @@ def choices(*values) -> Allowed:
     return Allowed(choices=tuple(values))
 
 
+_PYTHON_NAMES = contextvars.ContextVar("python_names", default=False)
+
+
+@contextlib.contextmanager
+def python_names() -> Iterator[None]:
+    """Within: errors name a setting as a Python call gives it (``lr``, ``lr=-1.0``), not as a flag."""
+    token = _PYTHON_NAMES.set(True)
+    try:
+        yield
+    finally:
+        _PYTHON_NAMES.reset(token)
+
+
+def in_python() -> bool:
+    """True within :func:`python_names` (a Python API call), False on the command line."""
+    return _PYTHON_NAMES.get()
+
+
 def flag(name: str) -> str:
-    return "--" + name.replace("_", "-")
+    """A config field as its caller names it: ``--batch-size`` on the command line, ``batch_size`` in Python."""
+    return name if in_python() else "--" + name.replace("_", "-")
+
+
+def setting(name: str, value) -> str:
+    """A field given a value, as its caller writes it: ``--hidden 64,64`` or ``hidden=(64, 64)``."""
+    if in_python():
+        return f"{name}={value!r}"
+    return f"{flag(name)} {shown(value) or '(empty)'}"
 
 
 def shown(value) -> str:
@@ -85,7 +117,9 @@ def invalid(name: str, value, allowed: str) -> UserError:
     """The one-line error for a bad value of field ``name``."""
     if isinstance(value, float) and not math.isfinite(value):
         allowed = allowed.replace("a number", "a finite number")
-    return UserError(f"{flag(name)} {shown(value) or '(empty)'} is invalid: allowed is {allowed}")
+    if in_python():
+        allowed = allowed.replace("a comma-separated list", "a list or tuple")
+    return UserError(f"{setting(name, value)} is invalid: allowed is {allowed}")
 
 
 def check_fields(cfg) -> None:
@@ -95,8 +129,9 @@ def check_fields(cfg) -> None:
         value = getattr(cfg, f.name)
         if allowed is None:
             continue
-        if isinstance(value, tuple):
-            if (not value and not allowed.empty_ok) or not all(allowed.accepts(item) for item in value):
+        if isinstance(value, tuple) or str(f.type).startswith("tuple"):  # a list field (hidden=64 is not one)
+            if (not isinstance(value, tuple) or (not value and not allowed.empty_ok)
+                    or not all(allowed.accepts(item) for item in value)):
                 empty = " (or empty)" if allowed.empty_ok else ""
                 raise invalid(f.name, value, f"a comma-separated list, each item {allowed.describe()}{empty}")
         elif not allowed.accepts(value):

@@ -9,7 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from rlcore.allowed import (COUNT, FINITE, NON_NEGATIVE, OFF_OR_COUNT, POSITIVE, UNIT, Allowed,
-                            check_fields, choices, require)
+                            check_fields, choices, flag, require, setting)
 
 TAU = Allowed(low=0, high=1, low_open=True)
 VEC = choices("inline", "processes")
@@ -22,11 +22,11 @@ def _h(default, text, allowed: Allowed | None = None, defines_run: bool = False)
 
 
 def _batch_fits_replay(cfg) -> None:
-    require(cfg.batch_size <= cfg.buffer_size, f"--batch-size {cfg.batch_size} is invalid: it must not "
-                                               f"exceed --buffer-size {cfg.buffer_size}")
+    require(cfg.batch_size <= cfg.buffer_size, f"{setting('batch_size', cfg.batch_size)} is invalid: it must "
+                                               f"not exceed {setting('buffer_size', cfg.buffer_size)}")
     # learning waits for this many stored transitions; a smaller memory would never hold them
-    require(cfg.learning_starts <= cfg.buffer_size, f"--learning-starts {cfg.learning_starts} is invalid: "
-                                                    f"it must not exceed --buffer-size {cfg.buffer_size}")
+    require(cfg.learning_starts <= cfg.buffer_size, f"{setting('learning_starts', cfg.learning_starts)} is "
+                                                    f"invalid: it must not exceed {setting('buffer_size', cfg.buffer_size)}")
 
 
 @dataclass(frozen=True)
@@ -65,7 +65,7 @@ class EpisodeLoop(RunBudget):
         inert = super().inert_fields()
         if not self.eval_every_steps:
             inert.update(dict.fromkeys(("eval_episodes", "keep_best", "stop_eval_score"),
-                                       "periodic evaluations are off; add --eval-every-steps"))
+                                       f"periodic evaluations are off; add {flag('eval_every_steps')}"))
         return inert
 
 
@@ -103,9 +103,10 @@ class DQNConfig(EpisodeLoop):
     def inert_fields(self) -> dict[str, str]:
         inert = super().inert_fields()
         if self.eps_schedule == "episode":
-            inert["eps_decay_steps"] = "it is the time constant of --eps-schedule steps, and the schedule is episode"
+            inert["eps_decay_steps"] = (f"it is the time constant of {setting('eps_schedule', 'steps')}, and the "
+                                        f"schedule is episode")
         else:
-            inert["eps_decay"] = "it is the factor of --eps-schedule episode, and the schedule is steps"
+            inert["eps_decay"] = f"it is the factor of {setting('eps_schedule', 'episode')}, and the schedule is steps"
         return inert
 
 
@@ -185,7 +186,7 @@ class PPOConfig(RunBudget):
         super().__post_init__()
         rollout = self.n_steps * self.num_envs
         require(rollout % self.minibatch == 0,
-                f"--minibatch {self.minibatch} is invalid: it must divide the rollout, n_steps x num_envs = "
+                f"{setting('minibatch', self.minibatch)} is invalid: it must divide the rollout, n_steps x num_envs = "
                 f"{self.n_steps} x {self.num_envs} = {rollout}")
 
 
@@ -217,6 +218,6 @@ class SACConfig(EpisodeLoop):
         super().__post_init__()
         _batch_fits_replay(self)
         require(self.log_std_min < self.log_std_max,
-                f"--log-std-min {self.log_std_min:g} is invalid: it must be below --log-std-max "
-                f"{self.log_std_max:g}")
+                f"{setting('log_std_min', self.log_std_min)} is invalid: it must be below "
+                f"{setting('log_std_max', self.log_std_max)}")
 

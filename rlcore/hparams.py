@@ -9,6 +9,7 @@ import argparse
 import dataclasses
 import typing
 
+from rlcore.allowed import flag, setting
 from rlcore.errors import UserError
 
 
@@ -76,8 +77,12 @@ def apply_overrides(cfg, overrides: dict):
     names = {f.name for f in dataclasses.fields(cfg)}
     unknown = sorted(set(overrides) - names)
     if unknown:
+        import difflib
+
+        near = [match for name in unknown for match in difflib.get_close_matches(name, names, n=1)]
+        guess = f"did you mean {flag(near[0])}? " if len(unknown) == 1 and near else ""
         raise UserError(f"unknown hyperparameter(s) {', '.join(unknown)} for {type(cfg).__name__}; "
-                        f"known: {', '.join(sorted(names))}")
+                        f"{guess}known: {', '.join(sorted(names))}")
     return dataclasses.replace(cfg, **overrides)
 
 
@@ -107,8 +112,7 @@ def check_same_run(recorded, overrides: dict, env_fields: tuple[str, ...], run_d
     of a defining field with another value than the recorded one is a :class:`UserError`."""
     for name in defining_fields(recorded, env_fields):
         if name in overrides and overrides[name] != getattr(recorded, name):
-            flag = "--" + name.replace("_", "-")
-            raise UserError(f"{flag} cannot change on --resume: the run in {run_dir} was recorded with "
+            raise UserError(f"{setting(name, overrides[name])} cannot change on a resume: the run in {run_dir} was recorded with "
                             f"{name} = {_shown(getattr(recorded, name))}, and it defines the env or the "
                             f"networks; start a new run to change it")
 
@@ -118,7 +122,7 @@ def check_no_inert(cfg, given) -> None:
     (the config's ``inert_fields()``: field -> why it does nothing)."""
     inert = getattr(cfg, "inert_fields", lambda: {})()
     for name in sorted(set(given) & set(inert)):
-        raise UserError(f"--{name.replace('_', '-')} does nothing here: {inert[name]}")
+        raise UserError(f"{flag(name)} does nothing here: {inert[name]}")
 
 
 def _shown(value) -> str:

@@ -17,6 +17,7 @@ import importlib
 from pathlib import Path
 from typing import Callable
 
+from rlcore.allowed import flag, in_python, setting
 from rlcore.experiment import get_experiment
 from rlcore.errors import UserError
 from rlcore.hparams import apply_overrides, check_no_inert, check_same_run, from_dict, to_dict
@@ -47,10 +48,10 @@ def build_spec(experiment: str, algo: str, *, preset: str | None = None, seed: i
         before, after = to_dict(recorded), to_dict(spec.config)
         spec.changes = {name: [before[name], after[name]] for name in overrides if before[name] != after[name]}
         if preset is not None and preset != state["preset"]:
-            raise UserError(f"--preset {preset} cannot change on --resume: the run in {run_dir} was started "
+            raise UserError(f"{setting('preset', preset)} cannot change on a resume: the run in {run_dir} was started "
                             f"from the {state['preset']} preset")
         if seed is not None and seed != state["seed"]:
-            raise UserError(f"--seed {seed} cannot change on --resume: the run in {run_dir} has seed "
+            raise UserError(f"{setting('seed', seed)} cannot change on a resume: the run in {run_dir} has seed "
                             f"{state['seed']}")
         spec.preset, spec.seed = state["preset"], state["seed"]
         if not nothing_to_train_ok:
@@ -70,7 +71,6 @@ def refuse_nothing_to_train(spec: RunSpec, state: dict) -> None:
     checkpoint (stopped between the two) goes on to write it."""
     import json
 
-    from rlcore.allowed import flag
     from rlcore.trainers.episodes import EpisodeBook
     from rlcore.trainers.periodic_eval import PeriodicEvaluation
     from rlcore.trainers.stopping import StopRules
@@ -90,7 +90,7 @@ def refuse_nothing_to_train(spec: RunSpec, state: dict) -> None:
         field, _, value = ended.partition(" ")
         raise UserError(f"nothing to train: the run in {spec.run_dir} is finished, and what ended it still holds "
                         f"({flag(field)} {value}, at episode {episodes:,}, env step {env_steps:,}); give a larger "
-                        f"budget (--episodes or --steps) or change that setting")
+                        f"budget ({flag('episodes')} or {flag('steps')}) or change that setting")
 
 
 def run_training(spec: RunSpec, on_progress: Callable[[dict, str], None] | None = None) -> Path:
@@ -130,8 +130,8 @@ def budget_overrides(episodes: int | None, steps: int | None, given: dict | None
     budget = {"max_episodes": episodes, "max_env_steps": steps}
     for name, value in budget.items():
         if value is not None and name in (given or {}):
-            short = "--episodes" if name == "max_episodes" else "--steps"
-            raise UserError(f"{short} and --{name.replace('_', '-')} set the same budget: give one")
+            short = flag("episodes" if name == "max_episodes" else "steps")
+            raise UserError(f"{short} and {flag(name)} set the same budget: give one")
     return {name: value for name, value in budget.items() if value is not None}
 
 
@@ -142,8 +142,9 @@ def check_new_run_dir(run_dir: Path) -> None:
 
     held = [name for name in (CHECKPOINT_FILE, "metrics.csv") if (Path(run_dir) / name).is_file()]
     if held:
-        raise UserError(f"--run-dir {run_dir} already holds a run ({held[0]}); continue it with --resume "
-                        f"{run_dir}, or give another --run-dir")
+        go_on = f"resume({str(run_dir)!r})" if in_python() else f"--resume {run_dir}"
+        raise UserError(f"{setting('run_dir', str(run_dir))} already holds a run ({held[0]}); continue it with "
+                        f"{go_on}, or give another {flag('run_dir')}")
 
 
 def train_and_evaluate(spec: RunSpec, final_eval_episodes: int | None = None,

@@ -54,6 +54,12 @@ def test_load_mistakes_are_user_errors(model, message):
     ({"seed": 901}, "seed=901 is invalid"), ({"seed": 2.5}, "seed=2.5 is invalid"), ({"seed": "3"}, "seed='3' is invalid"),
     ({"final_eval_episodes": -1}, "final_eval_episodes=-1 is invalid"), ({"episodes": 0}, "episodes=0 is invalid"),
     ({"steps": True}, "steps=True is invalid"),
+    # hyperparameters are named as the call gives them, not as the command line's flags
+    ({"lr": -1.0}, "^lr=-1.0 is invalid: allowed is a number above 0$"),
+    ({"hidden": 64}, "^hidden=64 is invalid: allowed is a list or tuple, each item a number of at least 1$"),
+    ({"batch_size": 512, "buffer_size": 100}, "^batch_size=512 is invalid: it must not exceed buffer_size=100$"),
+    ({"eps_decay": 0.9}, r"^eps_decay does nothing here: it is the factor of eps_schedule='episode'"),
+    ({"lrr": 0.1}, "^unknown hyperparameter.s. lrr for DQNConfig; did you mean lr\\? known: "),
 ])
 def test_train_checks_its_arguments_as_the_command_line_does_before_any_folder_exists(tmp_path, kwargs, message):
     from rlcore.allowed import check_whole
@@ -63,7 +69,8 @@ def test_train_checks_its_arguments_as_the_command_line_does_before_any_folder_e
     with pytest.raises(UserError, match=message):
         api.train("cartpole", "dqn", run_dir=tmp_path / "run", **{"episodes": 2, **kwargs})
     assert not (tmp_path / "run").exists()
-    if "seed" not in kwargs:  # resume takes the budgets too, and checks them before it reads the folder
+    if set(kwargs) <= {"episodes", "steps", "final_eval_episodes"}:  # resume takes the budgets too, and
+        # checks them before it reads the folder
         with pytest.raises(UserError, match=message):
             api.resume(tmp_path / "run", **kwargs)
 
@@ -90,7 +97,7 @@ def test_train_records_the_call_evaluates_and_renders(tmp_path):
         assert video == tmp_path / "clip.mp4" and reader.count_frames() > 1
     with pytest.raises(UserError, match="already holds a run"):
         api.train("cartpole", "dqn", run_dir=tmp_path / "run", episodes=1)
-    with pytest.raises(UserError, match="--episodes and --max-episodes set the same budget"):
+    with pytest.raises(UserError, match="^episodes and max_episodes set the same budget"):
         api.train("cartpole", "dqn", run_dir=tmp_path / "other", episodes=1, max_episodes=2)
     with pytest.raises(UserError, match="give a file name ending in .mp4 or .gif"):
         api.render(run, tmp_path / "clip.avi")
@@ -110,7 +117,7 @@ def test_resume_goes_on_from_the_checkpoint_records_the_call_and_what_it_changed
                                 + ", episodes=5, final_eval_episodes=2, lr=0.00025)"]
     assert meta["command_starts"][1]["changed"] == {"max_episodes": [3, 5], "lr": [5e-4, 2.5e-4]}
     assert (meta["episodes"], meta["seed"], meta["config"]["lr"], meta["evaluation"]["episodes"]) == (5, 1, 2.5e-4, 2)
-    with pytest.raises(UserError, match="hidden"):
+    with pytest.raises(UserError, match=r"^hidden=\(8, 8\) cannot change on a resume"):
         api.resume(tmp_path / "run", episodes=6, hidden=(8, 8))  # a network of another size is another run
     with pytest.raises(UserError, match="holds no checkpoint.npz to resume from"):
         api.resume(tmp_path / "nothing")

@@ -50,7 +50,7 @@ BAD_VALUES = [
     (["train", "mario_ppo", "ppo", "--world", "9"], "--world 9 is invalid: allowed is a number from 1 to 8"),
     # the minibatch divides the rollout; SAC's log-std clip is an interval
     (["train", "mario_ppo", "ppo", "--minibatch", "300"], "--minibatch 300 is invalid: it must divide the rollout"),
-    (["train", "minitaur", "sac", "--log-std-min", "3"], "--log-std-min 3 is invalid: it must be below"),
+    (["train", "minitaur", "sac", "--log-std-min", "3"], "--log-std-min 3.0 is invalid: it must be below --log-std-max"),
     # seeds, and evaluate / render counts
     (["train", "lunar_lander", "dqn", "--seed", "-1"], "argument --seed: -1 is invalid"),
     (["train", "lunar_lander", "dqn", "--seed", str(MAX_RUN_SEED + 1)], "argument --seed:"),

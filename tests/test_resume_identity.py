@@ -73,8 +73,8 @@ def test_resume_may_change_budgets_rates_and_coefficients(tmp_path):
 
 
 @pytest.mark.parametrize("argv, words", [
-    (["--seed", "3"], "--seed 3 cannot change on --resume"),
-    (["--preset", "article"], "--preset article cannot change on --resume"),
+    (["--seed", "3"], "--seed 3 cannot change on a resume"),
+    (["--preset", "article"], "--preset article cannot change on a resume"),
 ])
 def test_resume_refuses_another_seed_or_preset(capsys, tmp_path, argv, words):
     folder = fake_run(tmp_path / "run", "lunar_lander", "dqn")
