@@ -122,20 +122,46 @@ def invalid(name: str, value, allowed: str) -> UserError:
     return UserError(f"{setting(name, value)} is invalid: allowed is {allowed}")
 
 
+def _is_whole(value) -> bool:
+    try:
+        operator.index(value)  # int, numpy integers; not 64.0
+    except TypeError:
+        return False
+    return not isinstance(value, bool)
+
+
+def field_values(f: dataclasses.Field) -> str:
+    """What a config field allows, in words (``a whole number of at least 1`` for an ``int``; ``""``
+    without a declaration): for its error line, ``--help`` and the hyperparameters page."""
+    allowed = f.metadata.get("allowed")
+    if allowed is None:
+        return ""
+    if str(f.type) in ("int", "tuple[int, ...]") and not allowed.choices:
+        return _whole_words(allowed)
+    return allowed.describe()
+
+
+def _whole_words(allowed: Allowed) -> str:
+    return allowed.describe().replace("a number", "a whole number", 1)
+
+
 def check_fields(cfg) -> None:
-    """Raise :class:`UserError` for the first field of ``cfg`` outside its declared ``allowed``."""
+    """Raise :class:`UserError` for the first field of ``cfg`` outside its declared ``allowed``; a field
+    declared ``int`` (or a tuple of them) takes whole numbers only (the Python API could pass 64.5)."""
     for f in dataclasses.fields(cfg):
         allowed = f.metadata.get("allowed")
         value = getattr(cfg, f.name)
         if allowed is None:
             continue
+        whole = str(f.type) in ("int", "tuple[int, ...]")
+        describe = field_values(f)
+        fits = (lambda item: allowed.accepts(item) and (_is_whole(item) or not whole))
         if isinstance(value, tuple) or str(f.type).startswith("tuple"):  # a list field (hidden=64 is not one)
-            if (not isinstance(value, tuple) or (not value and not allowed.empty_ok)
-                    or not all(allowed.accepts(item) for item in value)):
+            if not isinstance(value, tuple) or (not value and not allowed.empty_ok) or not all(map(fits, value)):
                 empty = " (or empty)" if allowed.empty_ok else ""
-                raise invalid(f.name, value, f"a comma-separated list, each item {allowed.describe()}{empty}")
-        elif not allowed.accepts(value):
-            raise invalid(f.name, value, allowed.describe())
+                raise invalid(f.name, value, f"a comma-separated list, each item {describe}{empty}")
+        elif not fits(value):
+            raise invalid(f.name, value, describe)
 
 
 def whole_number(allowed: Allowed):
@@ -148,7 +174,7 @@ def whole_number(allowed: Allowed):
         except ValueError:
             raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
         if not allowed.accepts(value):
-            raise argparse.ArgumentTypeError(f"{value} is invalid: allowed is {allowed.describe()}")
+            raise argparse.ArgumentTypeError(f"{value} is invalid: allowed is {_whole_words(allowed)}")
         return value
     return parse
 
@@ -161,7 +187,7 @@ def check_whole(name: str, value, allowed: Allowed) -> None:
     except TypeError:
         number = None
     if number is None or not allowed.accepts(number):
-        raise UserError(f"{name}={value!r} is invalid: allowed is {allowed.describe().replace('a number', 'a whole number', 1)}")
+        raise UserError(f"{name}={value!r} is invalid: allowed is {_whole_words(allowed)}")
 
 
 def require(condition: bool, message: str) -> None:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 
+from rlcore.allowed import field_values
 from rlcore.docgen import GENERATED_NOTE, table
 from rlcore.experiment import experiment_names, get_experiment
 
@@ -73,9 +74,8 @@ def hyperparameters_page() -> str:
                 values = [_value(getattr(p, f.name)) if hasattr(p, f.name) else "–" for p in presets.values()]
                 # a value that differs from the default preset's is shown in bold
                 shown = [f"**{v}**" if v != values[list(presets).index(spec.default_preset)] else v for v in values]
-                allowed = f.metadata.get("allowed")
                 rows.append([f"`--{f.name.replace('_', '-')}`", *shown,
-                             allowed.describe() if allowed is not None else "true or false" if f.type in (bool, "bool") else "",
+                             field_values(f) or ("true or false" if f.type in (bool, "bool") else ""),
                              f.metadata.get("help", "").replace("%%", "%").replace("|", "\\|")])
             parts += [table(["flag", *[f"`{p}`" for p in presets], "allowed", "what it does"], rows), ""]
     return "\n".join(parts)

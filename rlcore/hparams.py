@@ -9,7 +9,7 @@ import argparse
 import dataclasses
 import typing
 
-from rlcore.allowed import flag, setting
+from rlcore.allowed import field_values, flag, setting
 from rlcore.errors import UserError
 
 
@@ -63,8 +63,7 @@ def add_arguments(parser: argparse.ArgumentParser, cfg) -> None:
 
 
 def _allowed_text(f: dataclasses.Field) -> str:
-    allowed = f.metadata.get("allowed")
-    return f"; allowed: {allowed.describe()}" if allowed is not None else ""
+    return f"; allowed: {values}" if (values := field_values(f)) else ""
 
 
 def overrides_from_args(args: argparse.Namespace) -> dict:

@@ -56,7 +56,9 @@ def test_load_mistakes_are_user_errors(model, message):
     ({"steps": True}, "steps=True is invalid"),
     # hyperparameters are named as the call gives them, not as the command line's flags
     ({"lr": -1.0}, "^lr=-1.0 is invalid: allowed is a number above 0$"),
-    ({"hidden": 64}, "^hidden=64 is invalid: allowed is a list or tuple, each item a number of at least 1$"),
+    ({"hidden": 64}, "^hidden=64 is invalid: allowed is a list or tuple, each item a whole number of at least 1$"),
+    ({"hidden": (16.5, 8)}, r"^hidden=\(16.5, 8\) is invalid: allowed is a list or tuple, each item a whole number"),
+    ({"batch_size": 64.0}, "^batch_size=64.0 is invalid: allowed is a whole number of at least 1$"),
     ({"batch_size": 512, "buffer_size": 100}, "^batch_size=512 is invalid: it must not exceed buffer_size=100$"),
     ({"eps_decay": 0.9}, r"^eps_decay does nothing here: it is the factor of eps_schedule='episode'"),
     ({"lrr": 0.1}, "^unknown hyperparameter.s. lrr for DQNConfig; did you mean lr\\? known: "),

@@ -47,7 +47,7 @@ BAD_VALUES = [
     (["train", "lunar_lander", "dqn", "--optimizer", "sgd"], "--optimizer sgd is invalid: allowed is one of adam, adamw"),
     (["train", "cartpole", "a2c", "--vec", "threads"], "--vec threads is invalid"),
     (["train", "mario_ppo", "ppo", "--actions", "fancy"], "--actions fancy is invalid"),
-    (["train", "mario_ppo", "ppo", "--world", "9"], "--world 9 is invalid: allowed is a number from 1 to 8"),
+    (["train", "mario_ppo", "ppo", "--world", "9"], "--world 9 is invalid: allowed is a whole number from 1 to 8"),
     # the minibatch divides the rollout; SAC's log-std clip is an interval
     (["train", "mario_ppo", "ppo", "--minibatch", "300"], "--minibatch 300 is invalid: it must divide the rollout"),
     (["train", "minitaur", "sac", "--log-std-min", "3"], "--log-std-min 3.0 is invalid: it must be below --log-std-max"),
@@ -61,7 +61,7 @@ BAD_VALUES = [
     (["render", "lunar_lander", "dqn", "--episodes", "0"], "argument --episodes: 0 is invalid"),
     # one unseen seed per evaluation episode: no more episodes than that range holds
     (["evaluate", "lunar_lander", "dqn", "--episodes", "1000001"], "argument --episodes: 1000001 is invalid: "
-                                                                   "allowed is a number from 1 to 1000000"),
+                                                                   "allowed is a whole number from 1 to 1000000"),
     (["render", "lunar_lander", "dqn", "--episodes", str(10**20)], "argument --episodes: "),
     (["train", "lunar_lander", "dqn", "--final-eval-episodes", "2000000"], "argument --final-eval-episodes: "
                                                                           "2000000 is invalid"),
