@@ -14,7 +14,7 @@ from mario_ppo.env import ACTION_SETS, FRAME_STACKS, make_env
 from mario_ppo.episode_ends import StallLimit
 from mario_ppo.levels import STAGE, WORLD
 from mario_ppo.restarts import KEEPS, WEIGHTS
-from rlcore.allowed import OFF_OR_COUNT, Allowed, choices, require
+from rlcore.allowed import OFF_OR_COUNT, Allowed, choices, flag, require
 from rlcore import extras
 from rlcore.configs import PPOConfig
 from rlcore.experiment import AlgoSpec, Bar, Curriculum, Experiment, Goal, SeedsBar, ShippedBy
@@ -89,21 +89,21 @@ class MarioPPOConfig(PPOConfig):
     def __post_init__(self):
         super().__post_init__()
         require(not (self.restart_x and self.restart_every),
-                "--restart-x and --restart-every are two ways to say where restarts start: give one")
+                f"{flag('restart_x')} and {flag('restart_every')} are two ways to say where restarts start: give one")
         require(not self.restart_back_step or self.restart_goal_x > self.restart_x > 0,
-                "--restart-back-step needs --restart-x and a --restart-goal-x past it")
+                f"{flag('restart_back_step')} needs {flag('restart_x')} and a {flag('restart_goal_x')} past it")
 
     def inert_fields(self) -> dict[str, str]:
         inert = super().inert_fields()
         if not (self.restart_x or self.restart_every):
             inert.update(dict.fromkeys(("restart_share", "restart_keep", "restart_weights"),
-                                       "there is no restart point; add --restart-x or --restart-every"))
+                                       f"there is no restart point; add {flag('restart_x')} or {flag('restart_every')}"))
         elif not self.restart_every:
-            inert["restart_weights"] = ("it weighs the points of --restart-every, and --restart-x gives a "
-                                        "single point")
+            inert["restart_weights"] = (f"it weighs the points of {flag('restart_every')}, and "
+                                        f"{flag('restart_x')} gives a single point")
         if not self.restart_back_step:
             inert.update(dict.fromkeys(("restart_goal_x", "restart_back_share"),
-                                       "it tunes --restart-back-step, which is off"))
+                                       f"it tunes {flag('restart_back_step')}, which is off"))
         return inert
 
 

@@ -14,10 +14,11 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import dataclasses
+import functools
 import math
 import operator
 from dataclasses import dataclass
-from typing import Iterator
+from typing import Callable, Iterator, ParamSpec, TypeVar
 
 from rlcore.errors import UserError
 
@@ -92,6 +93,24 @@ def python_names() -> Iterator[None]:
         _PYTHON_NAMES.reset(token)
 
 
+_P = ParamSpec("_P")
+_R = TypeVar("_R")
+
+
+def named_as_python(call: Callable[_P, _R]) -> Callable[_P, _R]:
+    """A Python API function whose errors name settings as the call gave them (:func:`python_names`)."""
+    @functools.wraps(call)
+    def named(*args: _P.args, **kwargs: _P.kwargs) -> _R:
+        with python_names():
+            return call(*args, **kwargs)
+    return named
+
+
+def resume_words(run_dir) -> str:
+    """How to continue the run in ``run_dir``: ``--resume DIR``, or ``api.resume('DIR')`` in Python."""
+    return f"api.resume({str(run_dir)!r})" if in_python() else f"--resume {run_dir}"
+
+
 def in_python() -> bool:
     """True within :func:`python_names` (a Python API call), False on the command line."""
     return _PYTHON_NAMES.get()
@@ -110,7 +129,12 @@ def setting(name: str, value) -> str:
 
 
 def shown(value) -> str:
-    return ",".join(map(str, value)) if isinstance(value, tuple) else str(value)
+    """A value as the command line takes it: ``64,64``, ``3`` for 3.0, ``0.0005``."""
+    if isinstance(value, tuple):
+        return ",".join(map(shown, value))
+    if isinstance(value, float) and math.isfinite(value) and float(f"{value:g}") == value:
+        return f"{value:g}"
+    return str(value)
 
 
 def invalid(name: str, value, allowed: str) -> UserError:

@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING, Any, Iterator, Literal, Union
 os.environ.setdefault("TF_CPP_MIN_LOG_LEVEL", "2")  # before anything imports TensorFlow, as main.py does
 import numpy as np
 
+from rlcore.allowed import named_as_python
 from rlcore.api_train import ProgressCallback, Run, WandbMode, resume, train
 from rlcore.errors import UserError
 from rlcore.experiment import Experiment
@@ -137,6 +138,7 @@ def model_folder(model: str | os.PathLike[str] | tuple[str, str]) -> Path:
     return folder
 
 
+@named_as_python
 def load(model: ModelRef | Policy) -> Policy:
     """The :class:`Policy` of ``model`` (see :data:`ModelRef`), rebuilt from its folder alone: its
     meta.json names the env (a Gymnasium id's registration included) and the network."""
@@ -165,6 +167,7 @@ def load(model: ModelRef | Policy) -> Policy:
 
 
 # ---------------------------------------------------------------------- evaluate, render
+@named_as_python
 def evaluate(model: ModelRef | Policy, episodes: int | None = None, seed_base: int | None = None,
              record: bool = False, record_further: bool = False) -> dict[str, Any]:
     """Evaluate on unseen seeds as ``main.py evaluate`` does (episode i seeded ``seed_base + i``,
@@ -194,6 +197,7 @@ def evaluate(model: ModelRef | Policy, episodes: int | None = None, seed_base: i
     return {**summary, "line": line}
 
 
+@named_as_python
 def render(model: ModelRef | Policy, out: str | os.PathLike[str] = "video.mp4", episodes: int | None = None,
            seed: int | None = None, fps: int | None = None) -> Path:
     """Film ``episodes`` episodes (default the experiment's, 1; Minitaur 3) into ``out``: an ``.mp4``,
@@ -222,6 +226,7 @@ def render_policy(policy: Policy, out: Path, fps: int | None, episodes: int | No
     return result
 
 
+@named_as_python
 def export(model: ModelRef | Policy, format: ExportFormat, out: str | os.PathLike[str],
            observations: int = 256) -> dict[str, Any]:
     """Export the acting network as a TF SavedModel, a TFLite file or an ONNX file into the folder

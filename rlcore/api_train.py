@@ -5,13 +5,12 @@ records; meta.json's ``command`` records the call."""
 from __future__ import annotations
 
 import contextlib
-import functools
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Iterator, Literal
 
-from rlcore.allowed import COUNT, check_whole, python_names
+from rlcore.allowed import COUNT, check_whole, named_as_python, resume_words
 from rlcore.command_line import FINAL_EVALUATION, RUN_SEEDS
 from rlcore.errors import UserError
 
@@ -48,16 +47,7 @@ class Run:
         return load(self.model_dir)
 
 
-def _naming_settings_as_python(call: Callable[..., Run]) -> Callable[..., Run]:
-    """Errors of the call name its settings as it took them (``lr=-1.0``), not as flags (``--lr -1.0``)."""
-    @functools.wraps(call)
-    def named(*args: Any, **kwargs: Any) -> Run:
-        with python_names():
-            return call(*args, **kwargs)
-    return named
-
-
-@_naming_settings_as_python
+@named_as_python  # errors name settings as the call gave them (lr=-1.0), not as flags
 def train(env: str, algo: str, *, preset: str | None = None, seed: int = 0,
           run_dir: str | os.PathLike[str] | None = None, episodes: int | None = None,
           steps: int | None = None, final_eval_episodes: int | None = None, wandb: WandbMode = "off",
@@ -95,7 +85,7 @@ def train(env: str, algo: str, *, preset: str | None = None, seed: int = 0,
                                final_eval_episodes, callback, progress)
 
 
-@_naming_settings_as_python
+@named_as_python
 def resume(run: str | os.PathLike[str] | Run, *, episodes: int | None = None, steps: int | None = None,
            final_eval_episodes: int | None = None, wandb: WandbMode = "off", progress: bool = True,
            callback: ProgressCallback | None = None, **hyperparameters: Any) -> Run:

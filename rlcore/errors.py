@@ -15,9 +15,9 @@ class WriteFailed(UserError):
     def __init__(self, path, exc: OSError):
         import errno
 
-        what = {errno.ENOSPC: "the disk is full: free some space (or write elsewhere), then --resume",
-                errno.EDQUOT: "the disk quota is used up: free some space, then --resume",
+        what = {errno.ENOSPC: "the disk is full: free some space (or write elsewhere), then resume the run",
+                errno.EDQUOT: "the disk quota is used up: free some space, then resume the run",
                 errno.EROFS: "the file system is read-only: write elsewhere",
-                errno.EACCES: "no permission to write there: write elsewhere"}.get(exc.errno, "check the disk and the folder, then --resume")
+                errno.EACCES: "no permission to write there: write elsewhere"}.get(exc.errno, "check the disk and the folder, then resume the run")
         super().__init__(f"cannot write {path}: {exc.strerror or exc}; {what}")
         self.errno = exc.errno

@@ -27,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
+from rlcore.allowed import flag, setting
 from rlcore.errors import UserError
 from rlcore.export_parity import (ABS_TOLERANCE, GREEDY_AGREEMENT, REL_TOLERANCE, OUTPUTS, ParityError, collect_observations,
                                   compare, runtime_of, versions)
@@ -204,12 +205,12 @@ WRITERS = {"savedmodel": _write_savedmodel, "tflite": _write_tflite, "onnx": _wr
 def _check_out(out_dir: Path) -> None:
     """Refuse, before any work, an ``--out`` that is a file or a folder holding something else."""
     if out_dir.exists() and not out_dir.is_dir():
-        raise UserError(f"--out {out_dir} is a file; give a folder for the export")
+        raise UserError(f"{setting('out', str(out_dir))} is a file; give a folder for the export")
     if out_dir.is_dir() and any(out_dir.iterdir()) and not (out_dir / "export.json").is_file():
-        raise UserError(f"--out {out_dir} holds files that are not an export; give a new or empty folder")
+        raise UserError(f"{setting('out', str(out_dir))} holds files that are not an export; give a new or empty folder")
     from rlcore.atomic import writable_folder
 
-    writable_folder(out_dir.parent, "--out")
+    writable_folder(out_dir.parent, flag("out"))
 
 
 def _move_into_place(tmp: Path, out_dir: Path) -> None:

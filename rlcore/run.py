@@ -17,7 +17,7 @@ import importlib
 from pathlib import Path
 from typing import Callable
 
-from rlcore.allowed import flag, in_python, setting
+from rlcore.allowed import flag, resume_words, setting
 from rlcore.experiment import get_experiment
 from rlcore.errors import UserError
 from rlcore.hparams import apply_overrides, check_no_inert, check_same_run, from_dict, to_dict
@@ -142,9 +142,8 @@ def check_new_run_dir(run_dir: Path) -> None:
 
     held = [name for name in (CHECKPOINT_FILE, "metrics.csv") if (Path(run_dir) / name).is_file()]
     if held:
-        go_on = f"resume({str(run_dir)!r})" if in_python() else f"--resume {run_dir}"
         raise UserError(f"{setting('run_dir', str(run_dir))} already holds a run ({held[0]}); continue it with "
-                        f"{go_on}, or give another {flag('run_dir')}")
+                        f"{resume_words(run_dir)}, or give another {flag('run_dir')}")
 
 
 def train_and_evaluate(spec: RunSpec, final_eval_episodes: int | None = None,

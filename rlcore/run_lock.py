@@ -49,7 +49,7 @@ def hold_run_folder(run_dir: str | os.PathLike) -> Iterator[Path]:
         if exc.errno not in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
             raise UserError(f"run folder {folder}: cannot lock it ({exc.strerror})") from None
         raise RunFolderBusy(f"run folder {folder} is being written by process {holder}; wait for it to end "
-                            f"(or stop it: kill {holder}), then --resume it") from None
+                            f"(or stop it: kill {holder}), then resume it") from None
     try:
         os.ftruncate(fd, 0)
         os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)  # who holds it, for the message above

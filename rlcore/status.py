@@ -17,6 +17,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 from rlcore.evaluation import count_causes
@@ -119,18 +120,21 @@ def pace(metrics_csv: Path, about: dict, span_seconds: float = 1800.0) -> tuple[
     df = read_table(metrics_csv, "env_steps")
     if "wall_seconds" not in df:
         return None
-    learning = df["grad_steps"].fillna(0) > 0 if "grad_steps" in df else None
+    grads = df["grad_steps"].fillna(0) if "grad_steps" in df else None  # a running count (DQN, SAC)
     df = df[["env_steps", "wall_seconds"]].dropna()
     # only the rows since either counter last went back (a table pieced together from two runs)
     back = ((df["wall_seconds"].diff() < 0) | (df["env_steps"].diff() < 0)).to_numpy().nonzero()[0]
     df = df.iloc[back[-1]:] if len(back) else df
-    if learning is not None:  # from the last row before its first gradient step (when it began to learn)
-        learning = learning.reindex(df.index)
-        if not learning.any():
+    if grads is not None and len(df):
+        # an episode learnt when the count grew over it; the pace is read from the row before the
+        # latest stretch of such episodes (its first steps, or a resume refilling an empty memory, take none)
+        grads = grads.reindex(df.index).to_numpy()
+        learnt = grads > np.concatenate(([0.0], grads[:-1]))
+        if not learnt[-1]:
             measured = _rate(df, span_seconds)
             return None if measured is None else (measured, None)
-        first = learning.to_numpy().nonzero()[0][0]
-        df = df.iloc[max(0, first - 1):]
+        idle = (~learnt).nonzero()[0]
+        df = df.iloc[idle[-1]:] if len(idle) else df
     rate = _rate(df, span_seconds)
     if rate is None:
         return None

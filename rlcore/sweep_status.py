@@ -59,28 +59,41 @@ def sweep_status(folder: str | Path) -> list[str]:
         lines.append(f"  {name}: checkpoint at {record['env_steps']:,} env steps, "
                      f"{record.get('wall_seconds', 0) / 3600:.1f} h" + (f", {text}" if text else "")
                      + (f"; last {last[0]}" if last else "") + critic_text)
-        left.append(measured[1] if measured else None)
+        trial_budget = (record.get("config") or {}).get("max_env_steps")
+        if measured and measured[1] is None and trial_budget and trial_budget < NO_BUDGET:
+            left.append(NotLearning(max(0, trial_budget - record["env_steps"])))  # no gradient step yet
+        else:
+            left.append(measured[1] if measured else None)
     budgets.discard(None)  # a record without its config says nothing of the budget
     budget = budgets.pop() if len(budgets) == 1 else None
     return lines + time_left(left, rates, budget if budget and budget < NO_BUDGET else None, sweep.max_concurrent)
 
 
+class NotLearning(float):
+    """A running trial that has taken no gradient step yet: the env steps it has left, which
+    :func:`time_left` prices at the finished trials' pace (its own first, random steps run faster)."""
+
+
 def time_left(left: list, rates: list[float], budget: int | None, at_once: int) -> list[str]:
     """The sweep's hours of training left, about: each running trial's to its env-step budget at its
-    pace lately, each trial not started over its whole budget at the finished trials' mean pace (a stop
-    rule may end any sooner, a slower pace later), ``at_once`` trials at a time (0: as many as the CPUs allow, unknown here,
-    so the sum is given), and never less than the longest trial's own. ``budget``: the trials' env-step
-    budget as their records hold it. No line when a part cannot be told."""
+    pace lately, each trial not started (over its whole budget) or not learning yet (over its steps
+    left, :class:`NotLearning`) at the finished trials' mean pace (a stop rule may end any sooner, a
+    slower pace later), ``at_once`` trials at a time (0: as many as the CPUs allow, unknown here, so the
+    sum is given), and never less than the longest trial's own. ``budget``: the trials' env-step budget
+    as their records hold it. No line when a part cannot be told."""
     waiting = left.count(NOT_STARTED)
-    if not left or any(part is None for part in left) or (waiting and not (rates and budget)):
+    early = [part for part in left if isinstance(part, NotLearning)]
+    if (not left or any(part is None for part in left) or (waiting and not budget)
+            or ((waiting or early) and not rates)):
         return []
-    each = [part for part in left if part != NOT_STARTED]
-    if waiting:
-        each += [budget / (sum(rates) / len(rates))] * waiting
+    mean_rate = sum(rates) / len(rates) if rates else math.nan
+    each = [float(part) for part in left if part != NOT_STARTED and not isinstance(part, NotLearning)]
+    each += [budget / mean_rate for _ in range(waiting)] + [steps / mean_rate for steps in early]
     seconds = max(sum(each) / max(1, at_once), max(each))
     if not (seconds > 0 and math.isfinite(seconds)):
         return []
     shared = f", {at_once} trial{'s' * (at_once > 1)} at a time" if at_once else " in all (trials at once not fixed)"
-    waiting_text = (f" ({waiting} trial{'s' * (waiting > 1)} not started, at the finished trials' mean pace)"
-                    if waiting else "")
+    priced = [f"{waiting} trial{'s' * (waiting > 1)} not started"] * bool(waiting) + [
+        f"{len(early)} not learning yet"] * bool(early)
+    waiting_text = f" ({', '.join(priced)}, at the finished trials' mean pace)" if priced else ""
     return [f"about {seconds / 3600:.1f} h of training left{shared}, at the paces seen{waiting_text}"]

@@ -14,6 +14,7 @@ import os
 import sys
 from pathlib import Path
 
+from rlcore.allowed import setting
 from rlcore.atomic import atomic_path
 from rlcore.errors import UserError
 
@@ -112,7 +113,8 @@ class Tracker:
         except Exception as exc:  # no network, bad key, service failure
             reason = str(exc).splitlines()[0][:200] if str(exc) else type(exc).__name__
             raise UserError(f"wandb could not start in {mode} mode ({reason}); "
-                            "use --wandb offline (sync later with `wandb sync`) or --wandb off")
+                            f"use {setting('wandb', 'offline')} (sync later with `wandb sync`) or "
+                            f"{setting('wandb', 'off')}")
 
     def _define_axes(self) -> None:
         """Every chart of every table against env steps, not wandb's own call counter."""

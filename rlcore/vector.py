@@ -126,7 +126,7 @@ class EnvPool:
             how = (f"killed by signal {-p.exitcode}" if p.exitcode is not None and p.exitcode < 0
                    else f"exited with code {p.exitcode}")
             parts.append(f"env worker {i} (pid {p.pid}) {how}")
-        return "; ".join(parts) + ": the env pool is closed; restart the run (or --resume it)"
+        return "; ".join(parts) + ": the env pool is closed; restart the run (or resume it)"
 
     def _terminate_workers(self) -> None:
         for process in self.envs.processes:

@@ -10,6 +10,7 @@ import imageio.v2 as imageio
 import imageio.v3 as iio
 import numpy as np
 
+from rlcore.allowed import setting
 from rlcore.atomic import atomic_path
 from rlcore.errors import UserError
 
@@ -98,7 +99,7 @@ def check_video_path(path: str | Path) -> Path:
     """``path`` if it names an MP4 or a GIF, else one clear error."""
     path = Path(path)
     if path.suffix.lower() not in VIDEO_SUFFIXES:
-        raise UserError(f"--out {path}: give a file name ending in .mp4 or .gif, or a folder (for an MP4)")
+        raise UserError(f"{setting('out', str(path))}: give a file name ending in .mp4 or .gif, or a folder (for an MP4)")
     return path
 
 

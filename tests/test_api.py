@@ -101,7 +101,7 @@ def test_train_records_the_call_evaluates_and_renders(tmp_path):
         api.train("cartpole", "dqn", run_dir=tmp_path / "run", episodes=1)
     with pytest.raises(UserError, match="^episodes and max_episodes set the same budget"):
         api.train("cartpole", "dqn", run_dir=tmp_path / "other", episodes=1, max_episodes=2)
-    with pytest.raises(UserError, match="give a file name ending in .mp4 or .gif"):
+    with pytest.raises(UserError, match=r"^out='.*clip\.avi': give a file name ending in \.mp4 or \.gif"):
         api.render(run, tmp_path / "clip.avi")
 
 

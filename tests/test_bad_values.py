@@ -33,15 +33,15 @@ BAD_VALUES = [
      "--learning-starts 200000 is invalid: it must not exceed --buffer-size 100000"),
     # probabilities, discount, tau, lambda, clip
     (["train", "lunar_lander", "dqn", "--gamma", "1.5"], "--gamma 1.5 is invalid: allowed is a number from 0 to 1"),
-    (["train", "lunar_lander", "dqn", "--tau", "0"], "--tau 0.0 is invalid: allowed is a number above 0 and at most 1"),
+    (["train", "lunar_lander", "dqn", "--tau", "0"], "--tau 0 is invalid: allowed is a number above 0 and at most 1"),
     (["train", "lunar_lander", "dqn", "--eps-end", "-0.1"], "--eps-end -0.1 is invalid"),
     (["train", "mario_ppo", "ppo", "--gae-lambda", "1.2"], "--gae-lambda 1.2 is invalid"),
-    (["train", "mario_ppo", "ppo", "--clip", "1"], "--clip 1.0 is invalid"),
-    (["train", "mario_ppo", "ppo", "--stop-success-share", "2"], "--stop-success-share 2.0 is invalid"),
+    (["train", "mario_ppo", "ppo", "--clip", "1"], "--clip 1 is invalid"),
+    (["train", "mario_ppo", "ppo", "--stop-success-share", "2"], "--stop-success-share 2 is invalid"),
     # learning rates positive and finite
     (["train", "lunar_lander", "dqn", "--lr", "nan"], "--lr nan is invalid: allowed is a finite number above 0"),
     (["train", "lunar_lander", "a2c", "--actor-lr", "inf"], "--actor-lr inf is invalid"),
-    (["train", "minitaur", "sac", "--alpha-lr", "0"], "--alpha-lr 0.0 is invalid"),
+    (["train", "minitaur", "sac", "--alpha-lr", "0"], "--alpha-lr 0 is invalid"),
     (["train", "lunar_lander", "dqn", "--stop-score", "nan"], "--stop-score nan is invalid"),
     # choices
     (["train", "lunar_lander", "dqn", "--optimizer", "sgd"], "--optimizer sgd is invalid: allowed is one of adam, adamw"),
@@ -50,7 +50,7 @@ BAD_VALUES = [
     (["train", "mario_ppo", "ppo", "--world", "9"], "--world 9 is invalid: allowed is a whole number from 1 to 8"),
     # the minibatch divides the rollout; SAC's log-std clip is an interval
     (["train", "mario_ppo", "ppo", "--minibatch", "300"], "--minibatch 300 is invalid: it must divide the rollout"),
-    (["train", "minitaur", "sac", "--log-std-min", "3"], "--log-std-min 3.0 is invalid: it must be below --log-std-max"),
+    (["train", "minitaur", "sac", "--log-std-min", "3"], "--log-std-min 3 is invalid: it must be below --log-std-max 2"),
     # seeds, and evaluate / render counts
     (["train", "lunar_lander", "dqn", "--seed", "-1"], "argument --seed: -1 is invalid"),
     (["train", "lunar_lander", "dqn", "--seed", str(MAX_RUN_SEED + 1)], "argument --seed:"),

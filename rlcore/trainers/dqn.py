@@ -41,7 +41,7 @@ def train(spec: RunSpec) -> Path:
 class EpsilonGreedy:
     """The DQN family's part of the episode loop: epsilon-greedy actions, with epsilon decayed per
     episode (article 000) or by env steps (the PyTorch tutorial, article 003)."""
-    name, divergence_hint = "DQN", "lower --lr"
+    name, divergence_hint = "DQN", "lower the learning rate"
 
     def __init__(self, agent: DQNAgent, cfg, rng: np.random.Generator, state: dict | None):
         self.agent, self.cfg, self.rng = agent, cfg, rng

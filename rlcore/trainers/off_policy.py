@@ -24,7 +24,7 @@ from rlcore.trainers.session import TrainingSession
 
 class Learner(Protocol):
     name: str  # "DQN", "SAC": the divergence message names it
-    divergence_hint: str  # what to try when the losses turn NaN ("lower --lr")
+    divergence_hint: str  # what to try when the losses turn NaN ("lower the learning rate")
     update_period: int  # env steps between two learning calls
 
     def act(self, obs: np.ndarray, env_steps: int) -> np.ndarray:

@@ -15,6 +15,7 @@ import numpy as np
 from tqdm.auto import tqdm  # a widget in a notebook, text in a terminal
 
 from rlcore.agents.ppo import MODEL_FILE, UPDATE_NAMES, PPOAgent
+from rlcore.allowed import setting
 from rlcore.cpu import bfloat16_note, cpu_flags
 from rlcore.errors import UserError
 from rlcore.trainers import checkpoints
@@ -118,7 +119,7 @@ def train(spec: RunSpec) -> Path:
                 session.advance(n)
             buf.close(agent.values(obs), truncated_values)
             collected = time.perf_counter()
-            with reported_divergence(session, "PPO", "lower --lr"):
+            with reported_divergence(session, "PPO", "lower the learning rate"):
                 losses = agent.update(*buf.arrays(), rng)
             rollouts += 1
             seconds = {"collect_seconds": round(collected - started, 3),  # where a rollout's time goes
@@ -148,7 +149,7 @@ def init_weights(agent: PPOAgent, folder: str, experiment: str, algo: str) -> di
 
     meta = read_meta(folder)
     if (meta.get("experiment"), meta.get("algo")) != (experiment, algo):
-        raise UserError(f"--init-from {folder} holds a {meta.get('experiment')} {meta.get('algo')} model, "
+        raise UserError(f"{setting('init_from', str(folder))} holds a {meta.get('experiment')} {meta.get('algo')} model, "
                         f"not {experiment} {algo}")
     source = load_keras_model(Path(folder) / MODEL_FILE, agent.obs_shape, agent.n_actions)
     agent.set_weights(source.get_weights())

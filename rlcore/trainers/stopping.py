@@ -19,6 +19,8 @@ from pathlib import Path
 
 from tqdm.auto import tqdm  # a widget in a notebook, text in a terminal
 
+from rlcore.allowed import resume_words
+
 
 # each asks for a stop at the next safe point, with a checkpoint (SIGHUP: the terminal closed, an ssh
 # connection dropped)
@@ -94,7 +96,7 @@ class Interrupted(Exception):
     """Raised after a stop request (Ctrl-C, SIGTERM, a stop file) once the checkpoint is safely written."""
 
     def __init__(self, checkpoint: Path):
-        super().__init__(f"interrupted; checkpoint saved to {checkpoint}; continue with --resume {checkpoint.parent}")
+        super().__init__(f"interrupted; checkpoint saved to {checkpoint}; continue with {resume_words(checkpoint.parent)}")
         self.checkpoint = checkpoint
 
 

@@ -104,6 +104,12 @@ def test_the_hours_left_are_read_from_the_pace_of_learning_not_of_the_random_fir
     assert pace(table, about) == pytest.approx((200.0, None))
     table.write_text("episode,env_steps,wall_seconds,grad_steps\n1,1000,10,5\n2,2000,20,10\n")  # from the start
     assert pace(table, about) == pytest.approx((100.0, 60.0))
+    # a resume that refills an empty memory (no gradient step, the count stays) and learns again
+    table.write_text("episode,env_steps,wall_seconds,grad_steps\n1,1000,10,5\n2,2000,20,10\n3,3000,25,10\n"
+                     "4,4000,35,20\n")
+    assert pace(table, about) == pytest.approx((100.0, 60.0))
+    table.write_text("episode,env_steps,wall_seconds,grad_steps\n1,1000,10,5\n2,2000,20,10\n3,3000,25,10\n")
+    assert pace(table, about)[1] is None  # refilling now: no hours told from it
 
 
 def test_a_finished_run_resumed_past_its_model_is_read_from_its_checkpoint(tmp_path):
@@ -122,7 +128,7 @@ def test_a_finished_run_resumed_past_its_model_is_read_from_its_checkpoint(tmp_p
 
 
 def test_the_sweeps_hours_left_are_never_fewer_than_its_longest_trials():
-    from rlcore.sweep_status import NOT_STARTED, time_left
+    from rlcore.sweep_status import NOT_STARTED, NotLearning, time_left
 
     assert time_left([3600.0], [], None, 4) == ["about 1.0 h of training left, 4 trials at a time, at the "
                                                 "paces seen"]
@@ -133,5 +139,10 @@ def test_the_sweeps_hours_left_are_never_fewer_than_its_longest_trials():
     # four trials of an hour each, two at a time: 2 h
     assert time_left([3600.0, 3600.0, NOT_STARTED, NOT_STARTED], [1.0], 3600, 2)[0].startswith(
         "about 2.0 h of training left, 2 trials at a time, at the paces seen (2 trials not started")
+    # a trial still taking its random first steps: its 7,200 steps left at the finished trials' 2 a second
+    assert time_left([NotLearning(7200), NOT_STARTED], [2.0], 3600, 1) == [
+        "about 1.5 h of training left, 1 trial at a time, at the paces seen (1 trial not started, 1 not "
+        "learning yet, at the finished trials' mean pace)"]
+    assert time_left([NotLearning(7200)], [], 3600, 1) == []  # no finished trial to take a pace from
     assert time_left([None, 3600.0], [], None, 1) == []  # a trial whose pace cannot be told
     assert time_left([NOT_STARTED], [], 1000, 1) == []  # no finished trial to take a pace from
