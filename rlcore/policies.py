@@ -29,6 +29,21 @@ def read_meta(model_dir: str | Path) -> dict:
         raise UserError(f"{meta_path} is damaged ({exc.msg} at line {exc.lineno})")
 
 
+def init_from_meta(folder: str | Path, experiment: str, algo: str) -> dict:
+    """The meta.json of the model folder a run starts from (PPO's ``init_from``), which must hold a model
+    of the same experiment and algorithm: a :class:`UserError` naming it otherwise."""
+    from rlcore.allowed import flag, setting
+
+    try:
+        meta = read_meta(folder)
+    except UserError as exc:
+        raise UserError(f"{flag('init_from')}: {exc}") from None
+    if (meta.get("experiment"), meta.get("algo")) != (experiment, algo):
+        raise UserError(f"{setting('init_from', str(folder))} holds a {meta.get('experiment')} {meta.get('algo')} "
+                        f"model, not {experiment} {algo}")
+    return meta
+
+
 def config_from_meta(exp, meta: dict):
     """The run's hyperparameters, rebuilt as the algorithm's config class."""
     from rlcore.hparams import from_dict

@@ -59,6 +59,10 @@ def build_spec(experiment: str, algo: str, *, preset: str | None = None, seed: i
         return spec
     config = apply_overrides(exp.preset(algo, preset), overrides)
     check_no_inert(config, overrides)
+    if getattr(config, "init_from", ""):  # PPO: a wrong folder is one line before any env process starts
+        from rlcore.policies import init_from_meta
+
+        init_from_meta(config.init_from, exp.name, algo)
     seed = 0 if seed is None else seed
     return RunSpec(exp, algo, preset or exp.algo(algo).default_preset, config, seed, wandb_mode,
                    Path(run_dir), progress=progress, **extra)

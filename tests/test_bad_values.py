@@ -51,6 +51,10 @@ BAD_VALUES = [
     # the minibatch divides the rollout; SAC's log-std clip is an interval
     (["train", "mario_ppo", "ppo", "--minibatch", "300"], "--minibatch 300 is invalid: it must divide the rollout"),
     (["train", "minitaur", "sac", "--log-std-min", "3"], "--log-std-min 3 is invalid: it must be below --log-std-max 2"),
+    # PPO's start from another model: a wrong folder is refused before any env process starts
+    (["train", "mario_ppo", "ppo", "--init-from", "/nonexistent"], "--init-from: /nonexistent: no such model folder"),
+    (["train", "mario_ppo", "ppo", "--init-from", "saved_networks/lunar_lander/dqn"],
+     "--init-from saved_networks/lunar_lander/dqn holds a lunar_lander dqn model, not mario_ppo ppo"),
     # seeds, and evaluate / render counts
     (["train", "lunar_lander", "dqn", "--seed", "-1"], "argument --seed: -1 is invalid"),
     (["train", "lunar_lander", "dqn", "--seed", str(MAX_RUN_SEED + 1)], "argument --seed:"),

@@ -15,9 +15,7 @@ import numpy as np
 from tqdm.auto import tqdm  # a widget in a notebook, text in a terminal
 
 from rlcore.agents.ppo import MODEL_FILE, UPDATE_NAMES, PPOAgent
-from rlcore.allowed import setting
 from rlcore.cpu import bfloat16_note, cpu_flags
-from rlcore.errors import UserError
 from rlcore.trainers import checkpoints
 from rlcore.trainers.divergence import reported_divergence
 from rlcore.trainers.lr_halving import LearningRateHalving
@@ -145,12 +143,9 @@ def init_weights(agent: PPOAgent, folder: str, experiment: str, algo: str) -> di
     """Load the weights of the model folder ``folder`` (``--init-from``) into ``agent``; return what
     that model was (its path, training commands, env steps, wall time, evaluation) for meta.json."""
     from rlcore.models import load_keras_model
-    from rlcore.policies import read_meta
+    from rlcore.policies import init_from_meta
 
-    meta = read_meta(folder)
-    if (meta.get("experiment"), meta.get("algo")) != (experiment, algo):
-        raise UserError(f"{setting('init_from', str(folder))} holds a {meta.get('experiment')} {meta.get('algo')} model, "
-                        f"not {experiment} {algo}")
+    meta = init_from_meta(folder, experiment, algo)  # checked in build_spec too, before any env starts
     source = load_keras_model(Path(folder) / MODEL_FILE, agent.obs_shape, agent.n_actions)
     agent.set_weights(source.get_weights())
     keep = ("config", "commands", "env_steps", "episodes", "wall_seconds", "evaluation", "init_from")
