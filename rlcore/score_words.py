@@ -17,5 +17,10 @@ def score_words(evaluation: dict, experiment: str, name: str, plus_minus: str = 
     if "success_share" in evaluation:
         won = round(evaluation["success_share"] * evaluation["episodes"])
         return f"{success_word(experiment, name)} in {won} of {evaluation['episodes']}"
-    digits = 1 if abs(evaluation["mean"]) >= 100 else 2
+    digits = return_digits(evaluation["mean"])
     return f"{evaluation['mean']:,.{digits}f} {plus_minus} {evaluation['std']:,.{digits}f}"
+
+
+def return_digits(mean: float) -> int:
+    """Decimals of a return near ``mean``: one from 100 up, two below (Minitaur's 20.45)."""
+    return 1 if abs(mean) >= 100 else 2

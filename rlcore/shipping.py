@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from rlcore.errors import UserError
+from rlcore.score_words import return_digits, score_words
 
 #: the saved_networks/ of the checkout this package runs from (``python main.py`` or an editable install)
 SAVED_NETWORKS = Path(__file__).resolve().parents[1] / "saved_networks"
@@ -63,7 +64,6 @@ def shipped_summary(folder: Path) -> str:
     """``shipped: 20.45 +- 3.99 over 30 episodes`` or ``1-1: flag in 8 of 10 episodes``, as the README
     writes the score (:mod:`rlcore.score_words`)."""
     from rlcore.policies import read_meta
-    from rlcore.score_words import score_words
 
     ev = read_meta(folder).get("evaluation")
     if not ev:
@@ -115,8 +115,10 @@ def run_evaluation(exp, policy, episodes: int, seed_base: int | None) -> tuple[d
                "std": round(float(returns.std()), 2), "min": round(float(returns.min()), 2),
                "time_limit_share": round(full / episodes, 3), "seeds": seeds, "policy": "greedy",
                "per_episode": records}
-    line = (f"greedy return {returns.mean():.1f} +- {returns.std():.1f} over {len(returns)} episodes "
-            f"(min {returns.min():.1f}, max {returns.max():.1f}); {full}/{episodes} lasted to the time limit")
+    digits = return_digits(float(returns.mean()))  # as the README and `list` write the recorded one
+    line = (f"greedy return {score_words(summary, exp.name, '', '+-')} over {len(returns)} episodes "
+            f"(min {returns.min():.{digits}f}, max {returns.max():.{digits}f}); {full}/{episodes} lasted to "
+            f"the time limit")
     for key in exp.info_keys:
         values = [r[key] for r in records if key in r]
         if values:
