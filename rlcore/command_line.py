@@ -127,7 +127,8 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
                                     "Gymnasium id: dqn, ddqn, dueling_dqn, dueling_ddqn, a2c, ppo (discrete "
                                     "actions) or sac (continuous actions)")
     train.add_argument("--preset", default=None, help=PRESET_HELP)
-    train.add_argument("--episodes", type=COUNT, default=None, help="episode budget (max_episodes)")
+    train.add_argument("--episodes", type=COUNT, default=None, help="episode budget (max_episodes): DQN and SAC stop at it; A2C "
+                       "and PPO check it after each rollout, so their envs may finish a few more")
     train.add_argument("--steps", type=COUNT, default=None, help="env step budget (max_env_steps), checked at the end of each episode (DQN, SAC) "
                        "or rollout (A2C, PPO: n_steps x num_envs env steps): a run ends at it or just past it")
     train.add_argument("--seed", type=SEED, default=None,
