@@ -166,8 +166,9 @@ EXPERIMENT = Experiment(
     bars={level: Bar("success_share", 0.8 if level == "1-1" else 0.5,
                      "article 001 reached the flag on every level from 1-1 to 2-4 but 1-3; we ask it in at "
                      "least 5 of 10 unseen-seed episodes on each level, and 8 of 10 on 1-1, the first level",
-                     over_seeds=SeedsBar("median", 0.8, "1-1's recipe from one command: its bar on the median of 3 "
-                                                        "seeds, and the other levels' bar on every seed", least=0.5)
+                     over_seeds=SeedsBar("median", 0.8, 3, "1-1's recipe from one command: its bar on the median "
+                                                           "of its seeds, and the other levels' bar on every seed",
+                                         least=0.5)
                      if level == "1-1" else None) for level in LEVEL_NAMES},
     info_keys=("stalled", "start_x", "killed_by"),
     eval_episodes=10, score_label="return (shaped, /10)",

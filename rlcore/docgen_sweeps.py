@@ -117,9 +117,11 @@ def seeds_bar_text(m) -> str:
     bar = m.bar.over_seeds if m.bar else None
     if bar is None or bar.statistic not in m.sweep.aggregates:
         return ""
-    met = bar.met_by(m.sweep.aggregates[bar.statistic][0], [score for _, score in m.sweep.seeds])
-    return (f" Bar over seeds: {bar.describe('success_share' in m.evaluation)} ({bar.reason}): "
-            f"**{'met' if met else 'not met'}**.")
+    scores = [score for _, score in m.sweep.seeds]
+    met = bar.met_by(m.sweep.aggregates[bar.statistic][0], scores)
+    verdict = ({True: "**met**", False: "**not met**"}[met] if met is not None
+               else f"not judged yet ({len(scores)} of {bar.seeds} seeds kept)")
+    return f" Bar over seeds: {bar.describe('success_share' in m.evaluation)} ({bar.reason}): {verdict}."
 
 
 def _hours(seconds: float) -> str:
@@ -127,14 +129,15 @@ def _hours(seconds: float) -> str:
 
 
 def evaluation_cell(evaluation: dict, m) -> str:
-    """``flag in 9 of 10`` (Mario), ``18.6 over 30``, and where the bar asks for episodes that last to the
-    time limit, ``18.6 over 30 (93% full length)``: one recorded evaluation, as the card writes it."""
+    """``flag in 9 of 10`` (Mario), ``257.4 over 100``, and where the bar asks for episodes that last to the
+    time limit, ``18.56 over 30 (93% full length)``: one recorded evaluation, with the digits of the
+    shipped score (:mod:`rlcore.score_words`)."""
     from rlcore.docgen import num
-    from rlcore.score_words import score_words
+    from rlcore.score_words import return_digits, score_words
 
     if "success_share" in evaluation:
         return score_words(evaluation, m.experiment, m.name)
-    text = f"{num(evaluation['mean'])} over {evaluation['episodes']}"
+    text = f"{num(evaluation['mean'], return_digits(evaluation['mean']))} over {evaluation['episodes']}"
     share = evaluation.get("time_limit_share")
     if share is not None and m.bar is not None and m.bar.full_length_share is not None:
         text += f" ({share:.0%} full length)"

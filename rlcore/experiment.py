@@ -36,23 +36,29 @@ class AlgoSpec:
 @dataclass(frozen=True)
 class SeedsBar:
     """What the shipped model's recipe must reach over seeds (its sweep, kept in ``results/sweeps/``), and
-    why: the ``statistic`` (``iqm`` or ``median``, as ``main.py report`` computes it) of the seeds' scores
-    at least ``value``, and, with ``least``, every seed at least that. Scores as the model's :class:`Bar`
-    reads them."""
+    why: over ``seeds`` seeds, the ``statistic`` (``iqm`` or ``median``, as ``main.py report`` computes
+    it) of their scores at least ``value``, and, with ``least``, every seed at least that. Scores as the
+    model's :class:`Bar` reads them. A sweep of fewer seeds is not judged."""
     statistic: str
     value: float
+    seeds: int
     reason: str
     least: float | None = None
 
-    def met_by(self, point: float, scores: list[float]) -> bool:
-        """Whether a sweep clears it: ``point``, the statistic over its seeds; ``scores``, each seed's."""
+    def met_by(self, point: float, scores: list[float]) -> bool | None:
+        """Whether a sweep clears it: ``point``, the statistic over its seeds; ``scores``, each seed's.
+        None (not judged) for fewer seeds than the bar is set over."""
+        if len(scores) < self.seeds:
+            return None
         return point >= self.value and (self.least is None or min(scores) >= self.least)
 
     def describe(self, share: bool) -> str:
-        """``IQM >= 11.3`` or ``median >= 80%, every seed >= 50%`` (``share``: scores are success shares)."""
+        """``IQM over 5 seeds >= 11.3`` or ``median over 3 seeds >= 80%, every seed >= 50%`` (``share``:
+        scores are success shares)."""
         show = (lambda v: f"{v:.0%}") if share else (lambda v: f"{v:g}")
         name = "IQM" if self.statistic == "iqm" else self.statistic
-        return f"{name} >= {show(self.value)}" + ("" if self.least is None else f", every seed >= {show(self.least)}")
+        return (f"{name} over {self.seeds} seeds >= {show(self.value)}"
+                + ("" if self.least is None else f", every seed >= {show(self.least)}"))
 
 
 @dataclass(frozen=True)

@@ -145,9 +145,9 @@ def test_a_seeds_score_gives_its_full_length_share_where_the_bar_asks_for_one():
     minitaur = SimpleNamespace(experiment="minitaur", name="sac", bar=get_experiment("minitaur").bar("sac"))
     lander = SimpleNamespace(experiment="lunar_lander", name="dqn", bar=get_experiment("lunar_lander").bar("dqn"))
     walked = {"mean": 18.56, "episodes": 30, "time_limit_share": 0.9333}
-    assert evaluation_cell(walked, minitaur) == "18.6 over 30 (93% full length)"
-    assert evaluation_cell(walked, lander) == "18.6 over 30"  # its bar asks for no such share
-    assert evaluation_cell({"mean": 18.56, "episodes": 30}, minitaur) == "18.6 over 30"  # not recorded
+    assert evaluation_cell(walked, minitaur) == "18.56 over 30 (93% full length)"
+    assert evaluation_cell(walked, lander) == "18.56 over 30"  # its bar asks for no such share
+    assert evaluation_cell({"mean": 18.56, "episodes": 30}, minitaur) == "18.56 over 30"  # not recorded
 
 
 def test_a_headline_recipe_is_held_to_its_bar_over_seeds_and_the_summary_says_whether_it_met_it():
@@ -162,17 +162,21 @@ def test_a_headline_recipe_is_held_to_its_bar_over_seeds_and_the_summary_says_wh
     minitaur = get_experiment("minitaur").bar("sac").over_seeds
     mario = get_experiment("mario_ppo").bar("1-1").over_seeds
     assert get_experiment("mario_ppo").bar("1-2").over_seeds is None
-    assert minitaur.met_by(11.3, [0.9, 30.0]) and not minitaur.met_by(11.29, [20.0] * 5)
+    assert minitaur.met_by(11.3, [0.9, 30.0, 11.3, 11.3, 11.3]) and not minitaur.met_by(11.29, [20.0] * 5)
+    assert minitaur.met_by(20.0, [20.0] * 4) is None  # 4 of its 5 seeds: not judged
     assert mario.met_by(0.8, [0.5, 0.8, 0.9]) and not mario.met_by(0.9, [0.4, 0.9, 1.0])  # one seed below 5 of 10
-    assert not mario.met_by(0.7, [0.6, 0.7, 1.0])
-    assert minitaur.describe(share=False) == "IQM >= 11.3"
-    assert mario.describe(share=True) == "median >= 80%, every seed >= 50%"
+    assert mario.met_by(0.7, [0.6, 0.7, 1.0]) is False
+    assert minitaur.describe(share=False) == "IQM over 5 seeds >= 11.3"
+    assert mario.describe(share=True) == "median over 3 seeds >= 80%, every seed >= 50%"
 
     def model(bar, evaluation, aggregates, seeds):
         return SimpleNamespace(bar=bar, evaluation=evaluation,
                                sweep=SimpleNamespace(aggregates=aggregates, seeds=list(enumerate(seeds))))
-    walk = model(get_experiment("minitaur").bar("sac"), {"mean": 20.45}, {"iqm": (13.4, 0.9, 20.8)}, [18.6, 20.8, 0.9])
-    assert seeds_bar_text(walk) == f" Bar over seeds: IQM >= 11.3 ({minitaur.reason}): **met**."
+    walk = model(get_experiment("minitaur").bar("sac"), {"mean": 20.45}, {"iqm": (13.4, 0.9, 20.8)},
+                 [18.6, 20.8, 0.9, 11.3, 12.0])
+    assert seeds_bar_text(walk) == f" Bar over seeds: IQM over 5 seeds >= 11.3 ({minitaur.reason}): **met**."
+    walk.sweep.seeds = walk.sweep.seeds[:4]
+    assert seeds_bar_text(walk).endswith("): not judged yet (4 of 5 seeds kept).")
     flags = model(get_experiment("mario_ppo").bar("1-1"), {"success_share": 0.8}, {"median": (0.9, 0.6, 1.0)},
                   [0.9, 1.0, 0.4])
     assert seeds_bar_text(flags).endswith("): **not met**.")
