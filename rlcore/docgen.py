@@ -23,7 +23,7 @@ import sys
 from rlcore.docgen_data import (ENV_IDS, GENERATED_NOTE, GIFS, REPO, Model, Sweep,  # noqa: F401 (used by the
                                 kept_sweeps, read_json, shipped_models)              # other docgen modules too)
 from rlcore.experiment import get_experiment, experiment_names
-from rlcore.score_words import score_words
+from rlcore.score_words import return_digits, score_words
 
 #: the docs page of each experiment (cartpole_v0 shares CartPole's page)
 EXPERIMENT_PAGES = {"lunar_lander": "lunar_lander", "cartpole": "cartpole", "cartpole_v0": "cartpole",
@@ -86,9 +86,11 @@ def bar_met(model: Model) -> str:
 
 
 def sweep_score(value: float, model: Model) -> str:
+    """A score of the model's experiment (a seed's, an IQM, an evaluation's) with the shipped score's
+    digits: ``257.4``, Minitaur's ``18.56``, or a share ``80%``."""
     if "success_share" in model.evaluation:
         return f"{value:.0%}"
-    return num(value)
+    return num(value, return_digits(model.evaluation["mean"]) if "mean" in model.evaluation else 1)
 
 
 def iqm_text(model: Model) -> str:

@@ -132,12 +132,12 @@ def evaluation_cell(evaluation: dict, m) -> str:
     """``flag in 9 of 10`` (Mario), ``257.4 over 100``, and where the bar asks for episodes that last to the
     time limit, ``18.56 over 30 (93% full length)``: one recorded evaluation, with the digits of the
     shipped score (:mod:`rlcore.score_words`)."""
-    from rlcore.docgen import num
-    from rlcore.score_words import return_digits, score_words
+    from rlcore.docgen import sweep_score
+    from rlcore.score_words import score_words
 
     if "success_share" in evaluation:
         return score_words(evaluation, m.experiment, m.name)
-    text = f"{num(evaluation['mean'], return_digits(evaluation['mean']))} over {evaluation['episodes']}"
+    text = f"{sweep_score(evaluation['mean'], m)} over {evaluation['episodes']}"
     share = evaluation.get("time_limit_share")
     if share is not None and m.bar is not None and m.bar.full_length_share is not None:
         text += f" ({share:.0%} full length)"

@@ -142,11 +142,13 @@ def test_a_seeds_score_gives_its_full_length_share_where_the_bar_asks_for_one():
     from rlcore.docgen_sweeps import evaluation_cell
     from rlcore.experiment import get_experiment
 
-    minitaur = SimpleNamespace(experiment="minitaur", name="sac", bar=get_experiment("minitaur").bar("sac"))
-    lander = SimpleNamespace(experiment="lunar_lander", name="dqn", bar=get_experiment("lunar_lander").bar("dqn"))
+    minitaur = SimpleNamespace(experiment="minitaur", name="sac", bar=get_experiment("minitaur").bar("sac"),
+                               evaluation={"mean": 20.45})  # the shipped model's: two decimals
+    lander = SimpleNamespace(experiment="lunar_lander", name="dqn", bar=get_experiment("lunar_lander").bar("dqn"),
+                             evaluation={"mean": 270.7})  # one decimal, as its shipped score
     walked = {"mean": 18.56, "episodes": 30, "time_limit_share": 0.9333}
     assert evaluation_cell(walked, minitaur) == "18.56 over 30 (93% full length)"
-    assert evaluation_cell(walked, lander) == "18.56 over 30"  # its bar asks for no such share
+    assert evaluation_cell(walked, lander) == "18.6 over 30"  # its bar asks for no such share
     assert evaluation_cell({"mean": 18.56, "episodes": 30}, minitaur) == "18.56 over 30"  # not recorded
 
 
