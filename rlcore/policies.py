@@ -39,8 +39,12 @@ def init_from_meta(folder: str | Path, experiment: str, algo: str) -> dict:
     except UserError as exc:
         raise UserError(f"{flag('init_from')}: {exc}") from None
     if (meta.get("experiment"), meta.get("algo")) != (experiment, algo):
-        raise UserError(f"{setting('init_from', str(folder))} holds a {meta.get('experiment')} {meta.get('algo')} "
-                        f"model, not {experiment} {algo}")
+        held = " ".join(str(meta[key]) for key in ("experiment", "algo") if meta.get(key)) or "no named"
+        raise UserError(f"{setting('init_from', str(folder))} holds a {held} model, not {experiment} {algo}")
+    network = Path(folder) / POLICY_FILES[get_experiment(experiment).algo(algo).kind]
+    if not network.is_file():
+        raise UserError(f"{setting('init_from', str(folder))} has a meta.json but no {network.name}: copy the "
+                        "whole model folder")
     return meta
 
 

@@ -36,6 +36,7 @@ def hold_run_folder(run_dir: str | os.PathLike) -> Iterator[Path]:
         finally:
             _held[folder][1] -= 1
         return
+    created = not folder.exists()
     try:
         folder.mkdir(parents=True, exist_ok=True)
         fd = os.open(folder / LOCK_FILE, os.O_RDWR | os.O_CREAT, 0o644)
@@ -57,4 +58,16 @@ def hold_run_folder(run_dir: str | os.PathLike) -> Iterator[Path]:
         yield folder
     finally:
         _held.pop(folder, None)
+        if created:
+            _drop_if_unwritten(folder)  # a run that failed before writing anything leaves no folder behind
         os.close(fd)  # closing the descriptor releases the lock
+
+
+def _drop_if_unwritten(folder: Path) -> None:
+    """Remove a folder this process created for a run, when the lock file is all it holds."""
+    try:
+        if [p.name for p in folder.iterdir()] == [LOCK_FILE]:
+            (folder / LOCK_FILE).unlink()
+            folder.rmdir()
+    except OSError:
+        pass  # something else appeared in it, or it went: leave it as it is

@@ -94,6 +94,28 @@ def test_a_bad_value_is_one_line_exit_2_and_no_run_folder(capsys, tmp_path, argv
     assert not run_dir.exists()
 
 
+@pytest.mark.parametrize("drop, argv, message", [
+    ("actor_critic.h5", [], "--init-from {m} has a meta.json but no actor_critic.h5"),
+    (None, ["--actions", "complex"], "--init-from: model {m}/actor_critic.h5 outputs (7,), expected (12,)"),
+])
+def test_init_from_a_model_that_does_not_fit_is_one_line_and_no_run_folder(tmp_path, drop, argv, message):
+    """A model folder with a good meta.json whose network is missing or fits another action set: one
+    line, exit 2, the env processes closed without a word of theirs, and no run folder left behind."""
+    import shutil
+
+    model, run_dir = tmp_path / "model", tmp_path / "run"
+    shutil.copytree(ROOT / "saved_networks/mario_ppo/1-1", model)
+    if drop:
+        (model / drop).unlink()
+    proc = subprocess.run([sys.executable, "main.py", "train", "mario_ppo", "ppo", "--init-from", str(model), *argv,
+                           "--num-envs", "2", "--vec", "processes", "--steps", "100", "--run-dir", str(run_dir),
+                           "--wandb", "off", "--no-progress"], cwd=ROOT, capture_output=True, text=True, timeout=300)
+    err = proc.stderr.strip()
+    assert proc.returncode == 2 and message.format(m=model) in err, err
+    assert len(err.splitlines()) == 1 and "Traceback" not in err, err
+    assert not run_dir.exists()
+
+
 UNWRITABLE = [  # BLOCK is a file, so nothing can be written "inside" it (as root too)
     (["train", "cartpole", "dqn", "--episodes", "1", "--wandb", "off", "--run-dir", "BLOCK/run"], "run folder"),
     (["render", "lunar_lander", "dqn", "--out", "BLOCK/demo.mp4"], "--out"),

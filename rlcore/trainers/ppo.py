@@ -15,7 +15,9 @@ import numpy as np
 from tqdm.auto import tqdm  # a widget in a notebook, text in a terminal
 
 from rlcore.agents.ppo import MODEL_FILE, UPDATE_NAMES, PPOAgent
+from rlcore.allowed import flag
 from rlcore.cpu import bfloat16_note, cpu_flags
+from rlcore.errors import UserError
 from rlcore.trainers import checkpoints
 from rlcore.trainers.divergence import reported_divergence
 from rlcore.trainers.lr_halving import LearningRateHalving
@@ -59,38 +61,42 @@ def train(spec: RunSpec) -> Path:
     keras.utils.set_random_seed(spec.seed)
     make_env = exp.training_env_factory(cfg)
     envs = EnvPool([make_env] * cfg.num_envs, mode=cfg.vec)
-    obs_shape, n_actions = envs.single_observation_space.shape, int(envs.single_action_space.n)
-    agent = PPOAgent(obs_shape, n_actions, cfg)
-    if note := bfloat16_note(cfg.precision, cpu_flags()):
-        tqdm.write(note)
-    rng = np.random.default_rng(spec.seed)
+    try:  # a start that fails (a wrong --init-from model, say) closes the env processes, then says why
+        obs_shape, n_actions = envs.single_observation_space.shape, int(envs.single_action_space.n)
+        agent = PPOAgent(obs_shape, n_actions, cfg)
+        if note := bfloat16_note(cfg.precision, cpu_flags()):
+            tqdm.write(note)
+        rng = np.random.default_rng(spec.seed)
 
-    curriculum = exp.curriculum
-    memory = curriculum.memory if curriculum else None  # what the envs build up (Mario: restart routes)
-    state, arrays = checkpoints.restore(spec, agent, rng)
-    if state is not None:
-        parent = state.get("init_from")
-        checkpoints.give_env_memory(envs, memory, arrays, curriculum.share_memory if curriculum else None, cfg)
-    else:
-        parent = init_weights(agent, cfg.init_from, exp.name, spec.algo) if cfg.init_from else None
-    session = TrainingSession(spec, state, progress_unit="step")
-    book = session.book
-    rollouts = int(state.get("rollouts", 0)) if state else 0
-    lr = LearningRateHalving(cfg.lr, cfg.lr_halve_at, state)
-    agent.set_learning_rate(lr.rate())  # a resume comes back at the rate its halvings left
+        curriculum = exp.curriculum
+        memory = curriculum.memory if curriculum else None  # what the envs build up (Mario: restart routes)
+        state, arrays = checkpoints.restore(spec, agent, rng)
+        if state is not None:
+            parent = state.get("init_from")
+            checkpoints.give_env_memory(envs, memory, arrays, curriculum.share_memory if curriculum else None, cfg)
+        else:
+            parent = init_weights(agent, cfg.init_from, exp.name, spec.algo) if cfg.init_from else None
+        session = TrainingSession(spec, state, progress_unit="step")
+        book = session.book
+        rollouts = int(state.get("rollouts", 0)) if state else 0
+        lr = LearningRateHalving(cfg.lr, cfg.lr_halve_at, state)
+        agent.set_learning_rate(lr.rate())  # a resume comes back at the rate its halvings left
 
-    env_kept = {}  # what the envs built up (Mario: the restart routes), read while the pool is open
+        env_kept = {}  # what the envs built up (Mario: the restart routes), read while the pool is open
 
-    def checkpoint():
-        checkpoints.save(session, agent, rng, env_arrays=env_kept, rollouts=rollouts, init_from=parent,
-                         **lr.state())
+        def checkpoint():
+            checkpoints.save(session, agent, rng, env_arrays=env_kept, rollouts=rollouts, init_from=parent,
+                             **lr.state())
 
-    t, n = cfg.n_steps, cfg.num_envs
-    buf = Rollout(t, n, obs_shape, agent.obs_dtype)
-    running = np.zeros(n)
-    losses = {name: float("nan") for name in UPDATE_NAMES}  # CSV columns exist from the first row
-    # a resumed run starts fresh episodes, reseeded from its episode count
-    obs, _ = envs.reset(seed=session.fresh_env_seeds(n))
+        t, n = cfg.n_steps, cfg.num_envs
+        buf = Rollout(t, n, obs_shape, agent.obs_dtype)
+        running = np.zeros(n)
+        losses = {name: float("nan") for name in UPDATE_NAMES}  # CSV columns exist from the first row
+        # a resumed run starts fresh episodes, reseeded from its episode count
+        obs, _ = envs.reset(seed=session.fresh_env_seeds(n))
+    except BaseException:
+        envs.close()
+        raise
     with envs, session.interruptible():
         while not session.should_stop():
             log = RolloutLog(exp)
@@ -146,7 +152,10 @@ def init_weights(agent: PPOAgent, folder: str, experiment: str, algo: str) -> di
     from rlcore.policies import init_from_meta
 
     meta = init_from_meta(folder, experiment, algo)  # checked in build_spec too, before any env starts
-    source = load_keras_model(Path(folder) / MODEL_FILE, agent.obs_shape, agent.n_actions)
+    try:
+        source = load_keras_model(Path(folder) / MODEL_FILE, agent.obs_shape, agent.n_actions)
+    except UserError as exc:  # a missing, damaged or wrong-shaped model: named as the setting that gave it
+        raise UserError(f"{flag('init_from')}: {exc}") from None
     agent.set_weights(source.get_weights())
     keep = ("config", "commands", "env_steps", "episodes", "wall_seconds", "evaluation", "init_from")
     return {"path": str(folder), **{k: meta[k] for k in keep if k in meta}}
