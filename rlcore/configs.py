@@ -15,9 +15,10 @@ TAU = Allowed(low=0, high=1, low_open=True)
 VEC = choices("inline", "processes")
 
 
-def _h(default, text, allowed: Allowed | None = None, defines_run: bool = False):
-    """A field with its help and allowed values; ``defines_run``: it shapes the env or the networks, so
-    a resume may not change it (:func:`rlcore.hparams.check_same_run`)."""
+def _h(default, text, allowed: Allowed | None = None, defines_run: bool | str = False):
+    """A field with its help and allowed values; ``defines_run``: it shapes the env or the networks (or,
+    given as words, what they say it defines), so a resume may not change it
+    (:func:`rlcore.hparams.check_same_run`)."""
     return field(default=default, metadata={"help": text, "allowed": allowed, "defines_run": defines_run})
 
 
@@ -32,7 +33,8 @@ def _batch_fits_replay(cfg) -> None:
 @dataclass(frozen=True)
 class RunBudget:
     """When a run stops and how it keeps score; shared by every algorithm's config."""
-    max_episodes: int = _h(2000, "stop after this many finished episodes", COUNT)
+    max_episodes: int = _h(2000, "stop after this many finished episodes (A2C and PPO: checked after each "
+                                 "rollout, so a run may finish more)", COUNT)
     max_env_steps: int = _h(0, "stop after this many env steps, all envs together (0 = no limit)",
                             OFF_OR_COUNT)
     max_episode_steps: int = _h(1000, "cap on steps per episode, longer ones are truncated "
@@ -180,7 +182,8 @@ class PPOConfig(RunBudget):
     stop_success_share: float = _h(0.0, "stop once this share of the last `window` episodes "
                                         "succeeded, e.g. reached the flag (0 = off)", UNIT)
     init_from: str = _h("", "start from the weights of this model folder (e.g. another level's "
-                            "saved_networks/mario_ppo/1-1); empty = random initial weights")
+                            "saved_networks/mario_ppo/1-1); empty = random initial weights",
+                        defines_run="the weights the run started from")
 
     def __post_init__(self):
         super().__post_init__()

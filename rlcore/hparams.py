@@ -109,11 +109,13 @@ def defining_fields(cfg, env_fields: tuple[str, ...] = ()) -> list[str]:
 def check_same_run(recorded, overrides: dict, env_fields: tuple[str, ...], run_dir) -> None:
     """A resume may change budgets, rates, coefficients and logging, not what the run is: an override
     of a defining field with another value than the recorded one is a :class:`UserError`."""
+    defines = {f.name: f.metadata.get("defines_run") for f in dataclasses.fields(recorded)}
     for name in defining_fields(recorded, env_fields):
         if name in overrides and overrides[name] != getattr(recorded, name):
+            what = defines[name] if isinstance(defines[name], str) else "the env or the networks"
             raise UserError(f"{setting(name, overrides[name])} cannot change on a resume: the run in {run_dir} was recorded with "
-                            f"{name} = {_shown(getattr(recorded, name))}, and it defines the env or the "
-                            f"networks; start a new run to change it")
+                            f"{name} = {_shown(getattr(recorded, name))}, and it defines {what}; start a new run "
+                            "to change it")
 
 
 def check_no_inert(cfg, given) -> None:
@@ -125,6 +127,8 @@ def check_no_inert(cfg, given) -> None:
 
 
 def _shown(value) -> str:
+    if value == "":
+        return "'' (none)"
     return ",".join(map(str, value)) if isinstance(value, tuple) else str(value)
 
 

@@ -28,6 +28,7 @@ def fake_run(folder, experiment: str, algo: str, preset: str = "default", seed: 
     ("mario_ppo", "ppo", "--frames", "history"),
     ("mario_ppo", "ppo", "--actions", "complex"),
     ("mario_ppo", "ppo", "--num-envs", "4"),
+    ("mario_ppo", "ppo", "--init-from", "saved_networks/mario_ppo/1-1"),  # recorded, and used only at its start
     ("lunar_lander", "dqn", "--hidden", "32,32"),
     ("lunar_lander", "dueling_ddqn", "--dueling", "false"),
     ("minitaur", "sac", "--obs-norm", "false"),
@@ -50,7 +51,7 @@ def test_resume_refuses_a_change_of_what_the_run_is(capsys, tmp_path, experiment
 def test_every_env_field_and_network_size_is_a_defining_field():
     mario = get_experiment("mario_ppo")
     fields = defining_fields(mario.preset("ppo", None), mario.env_fields)
-    for name in ("world", "stage", "actions", "frames", "num_envs", "max_episode_steps"):
+    for name in ("world", "stage", "actions", "frames", "num_envs", "max_episode_steps", "init_from"):
         assert name in fields
     for name in ("lr", "entropy_coef", "max_env_steps", "checkpoint_rollouts", "precision", "restart_x"):
         assert name not in fields  # budgets, rates, coefficients, logging and curricula may change
