@@ -105,6 +105,11 @@ def parse_seeds(text: str) -> list[int]:
     return seeds
 
 
+# settings a grid may not vary, and why
+UNSWEPT = {"init_from": "each trial's folder is named by its values, and a path cannot be part of a folder's "
+                        "name; fine-tune one run with `main.py train ... --init-from`"}
+
+
 def parse_grid(items: list[str], config) -> dict[str, list]:
     """``["lr=1e-4,3e-4", "world=1,2"]`` -> ``{"lr": [0.0001, 0.0003], "world": [1, 2]}``, each value
     parsed by its field's type; an unknown name is a :class:`UserError`."""
@@ -120,6 +125,8 @@ def parse_grid(items: list[str], config) -> dict[str, list]:
         if name not in types:
             raise UserError(f"--grid {item!r}: {name!r} is not a hyperparameter of {type(config).__name__}; "
                             f"`main.py train EXPERIMENT ALGO --help` lists them")
+        if name in UNSWEPT:
+            raise UserError(f"--grid {item!r}: a sweep cannot vary {name} ({UNSWEPT[name]})")
         try:
             # tuple fields (hidden sizes) take ';' between values: --grid hidden=64,64;128,128
             sep_values = values.split(";") if isinstance(getattr(config, name), tuple) else values.split(",")
