@@ -128,7 +128,7 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
                                     "actions) or sac (continuous actions)")
     train.add_argument("--preset", default=None, help=PRESET_HELP)
     train.add_argument("--episodes", type=COUNT, default=None, help="episode budget (max_episodes): DQN and SAC stop at it; A2C "
-                       "and PPO check it after each rollout, so their envs may finish a few more")
+                       "and PPO check it after each rollout, so their envs may finish more, up to a rollout's worth")
     train.add_argument("--steps", type=COUNT, default=None, help="env step budget (max_env_steps), checked at the end of each episode (DQN, SAC) "
                        "or rollout (A2C, PPO: n_steps x num_envs env steps): a run ends at it or just past it")
     train.add_argument("--seed", type=SEED, default=None,
@@ -200,7 +200,8 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
     sweep.add_argument("--grid", action="append", default=[], metavar="NAME=V1,V2",
                        help="a hyperparameter and its values (repeatable), e.g. --grid lr=1e-4,3e-4")
     sweep.add_argument("--preset", default=None, help=PRESET_HELP)
-    sweep.add_argument("--episodes", type=COUNT, default=None, help="episode budget of each run")
+    sweep.add_argument("--episodes", type=COUNT, default=None, help="episode budget of each run (as train's --episodes: A2C and PPO "
+                       "check it after each rollout)")
     sweep.add_argument("--steps", type=COUNT, default=None, help="env step budget of each run (as train's --steps: it ends at the end of the "
                        "episode or rollout that reaches it)")
     sweep.add_argument("--final-eval-episodes", type=FINAL_EVAL_EPISODES, default=None,

@@ -46,6 +46,11 @@ def num(value: float, digits: int = 1) -> str:
     return f"{value:,.{digits}f}"
 
 
+def ret(value: float, near: float | None = None) -> str:
+    """A return with the README's digits for a score near ``near`` (itself when not given): 257.4, 18.56."""
+    return num(value, return_digits(value if near is None else near))
+
+
 def score_value(model: Model) -> float | None:
     ev = model.evaluation
     return ev.get("success_share", ev.get("mean"))
@@ -173,7 +178,7 @@ def region_shipped(page: str, experiment: str) -> str:
         meta, best = m.meta, m.meta.get("best_eval") or {}
         rows.append([f"[{m.name}]({link(page, card_path(m, page))})", f"`{meta.get('preset')}`",
                      f"{meta['env_steps']:,}", f"{meta['episodes']:,}", f"{meta['wall_seconds']:,.0f} s",
-                     num(best["mean"]) if "mean" in best else "–",
+                     ret(best["mean"]) if "mean" in best else "–",
                      f"**{score_text(m)}** ({m.evaluation.get('episodes', '?')} ep.)",
                      f"{bar_text(m)}: {bar_met(m)}" if m.bar else "none set"])
     return table(["model", "preset", "env steps", "episodes", "wall", "best selection eval",

@@ -6,7 +6,7 @@ import json
 from pathlib import Path
 
 from rlcore.docgen import (GENERATED_NOTE, REPO, Model, bar_met, bar_text, eval_text, iqm_text, link,
-                           model_page, num, policy_text, region_bars, region_shipped, region_sweeps,
+                           model_page, num, policy_text, ret, region_bars, region_shipped, region_sweeps,
                            score_text, sweep_score, table, EXPERIMENT_PAGES, article_of)
 from rlcore.docgen_sweeps import stop_text
 from rlcore.experiment import experiment_names, get_experiment
@@ -53,7 +53,7 @@ def score_section(m: Model, page: str, docs: bool) -> str:
         if ev.get("causes"):
             rows += [["what ended the misses", ", ".join(f"{k} {v}" for k, v in ev["causes"].items())]]
     else:
-        rows += [["lowest episode", num(ev["min"], 1 if abs(ev["mean"]) >= 100 else 2)]]
+        rows += [["lowest episode", ret(ev["min"], ev["mean"])]]
         if "time_limit_share" in ev:
             rows += [["episodes that lasted to the time limit", f"{ev['time_limit_share']:.0%}"]]
         if "mean_x" in ev:
@@ -64,7 +64,7 @@ def score_section(m: Model, page: str, docs: bool) -> str:
     best = meta.get("best_eval") or {}
     if "mean" in best:
         rows += [["best periodic evaluation during training (selection seeds, not unseen)",
-                  f"{num(best['mean'])} at {best.get('env_steps', 0):,} env steps"]]
+                  f"{ret(best['mean'])} at {best.get('env_steps', 0):,} env steps"]]
     text = table(["evaluation", "result"], rows) + "\n"
     if m.sweep:
         agg = m.sweep.aggregates
@@ -78,7 +78,7 @@ def score_section(m: Model, page: str, docs: bool) -> str:
         key = "success" if "success_share" in ev else "return"
         cells = []
         for r in per_episode:
-            value = ("yes" if r["success"] else "no") if key == "success" else f"{r['return']:.1f}"
+            value = ("yes" if r["success"] else "no") if key == "success" else ret(r["return"], ev["mean"])
             cells.append(f"{r['seed']}: {value}")
         body = ", ".join(cells)
         title = f"Every episode of the evaluation (seed: {'reached the flag' if key == 'success' else 'return'})"
@@ -152,7 +152,7 @@ def training_section(m: Model, page: str) -> str:
     if isinstance(parent, dict):
         pev = parent.get("evaluation") or {}
         score = (f"{round(pev['success_share'] * pev['episodes'])} of {pev['episodes']}" if "success_share" in pev
-                 else f"{num(pev['mean'])}" if "mean" in pev else "not evaluated")
+                 else ret(pev["mean"]) if "mean" in pev else "not evaluated")
         text += (f"\nIt started from the weights of `{parent.get('path')}` (`--init-from`), a run of "
                  f"{parent.get('env_steps', 0):,} env steps and {parent.get('wall_seconds', 0):,.0f} s "
                  f"(its evaluation: {score}), trained by:\n\n" + commands_table(parent.get("commands") or []) + "\n")

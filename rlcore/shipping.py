@@ -115,7 +115,7 @@ def run_evaluation(exp, policy, episodes: int, seed_base: int | None) -> tuple[d
                "std": round(float(returns.std()), 2), "min": round(float(returns.min()), 2),
                "time_limit_share": round(full / episodes, 3), "seeds": seeds, "policy": "greedy",
                "per_episode": records}
-    digits = return_digits(float(returns.mean()))  # as the README and `list` write the recorded one
+    digits = return_digits(summary["mean"])  # as score_words, the README and `list` write the recorded one
     line = (f"greedy return {score_words(summary, exp.name, '', '+-')} over {len(returns)} episodes "
             f"(min {returns.min():.{digits}f}, max {returns.max():.{digits}f}); {full}/{episodes} lasted to "
             f"the time limit")
