@@ -5,8 +5,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from rlcore.docgen import (GENERATED_NOTE, REPO, Model, bar_met, bar_text, eval_text, iqm_text, link,
-                           model_page, num, policy_text, ret, region_bars, region_shipped, region_sweeps,
+from rlcore.docgen import (GENERATED_NOTE, REPO, Model, bar_met, bar_text, eval_text, link, OVER_SEEDS_HEADER,
+                           model_page, num, over_seeds_bold, over_seeds_cell, policy_text, ret, region_bars, region_shipped, region_sweeps,
                            score_text, sweep_score, table, EXPERIMENT_PAGES, article_of)
 from rlcore.docgen_sweeps import stop_text
 from rlcore.experiment import experiment_names, get_experiment
@@ -69,7 +69,7 @@ def score_section(m: Model, page: str, docs: bool) -> str:
     if m.sweep:
         agg = m.sweep.aggregates
         text += (f"\nThe same recipe over {len(m.sweep.seeds)} seeds ([report]({link(page, m.sweep.folder + '/report.md')}),"
-                 f" each run scored like this one): IQM **{iqm_text(m)}**")
+                 f" each run scored like this one): {over_seeds_bold(m)}")
         if "mean" in agg:
             text += f", mean {sweep_score(agg['mean'][0], m)}"
         text += "; per seed " + ", ".join(f"{s}: {sweep_score(v, m)}" for s, v in m.sweep.seeds) + ".\n"
@@ -223,13 +223,13 @@ def cards(models: list[Model]) -> dict[str, str]:
 def model_pages(models: list[Model]) -> dict[str, str]:
     out = {model_page(m): GENERATED_NOTE + "\n\n" + body(m, model_page(m), True) for m in models}
     rows = [[f"[{m.slug}]({m.slug}.md)", m.env_id, f"`{m.algo}`", f"**{score_text(m)}**", bar_text(m), bar_met(m),
-             iqm_text(m), "yes" if m.gif else "–"] for m in models]
+             over_seeds_cell(m), "yes" if m.gif else "–"] for m in models]
     out["docs/models/index.md"] = "\n".join([
         GENERATED_NOTE, "", "# Models", "",
         f"Every shipped model has a card: its score on unseen seeds, how to use it, every command that trained "
         f"it, and its files. The same card sits beside the model as `saved_networks/.../README.md`, with "
         f"front matter the Hugging Face Hub reads.", "",
-        table(["model", "env", "algorithm", "score on unseen seeds", "bar", "", "5-seed IQM [95% CI]", "GIF"], rows),
+        table(["model", "env", "algorithm", "score on unseen seeds", "bar", "", OVER_SEEDS_HEADER, "GIF"], rows),
         ""])
     return out
 

@@ -94,14 +94,14 @@ def sweep_stability(page: str, experiment: str) -> str:
 
 
 def seed_summary(page: str, experiment: str) -> str:
-    from rlcore.docgen import iqm_text, link, score_text
+    from rlcore.docgen import link, over_seeds_bold, score_text
 
     parts = []
     for m, runs in _kept_sweeps(experiment):
         per_seed = "; ".join(f"{meta['seed']}: {evaluation_cell(meta['evaluation'], m)} after "
                              f"{meta['env_steps']:,} env steps, {_hours(meta['wall_seconds'])}" for meta, _ in runs)
         parts.append(f"{m.title}, the same recipe over {len(m.sweep.seeds)} seeds "
-                     f"([report]({link(page, m.sweep.folder + '/report.md')})): IQM [95% CI] **{iqm_text(m)}**; "
+                     f"([report]({link(page, m.sweep.folder + '/report.md')})): {over_seeds_bold(m, '[95% CI] ')}; "
                      f"per seed {per_seed}; the shipped model (seed {m.meta.get('seed')}, a run of its own) "
                      f"{score_text(m)}." + seeds_bar_text(m)
                      + (f" During training {stability_summary([st for _, st in runs])}"

@@ -1,4 +1,4 @@
-"""The README's "IQM [95% CI] over 5 seeds" figures are recomputed from the sweep results git keeps
+"""The README's "same recipe over seeds [95% CI]" figures are recomputed from the sweep results git keeps
 (`results/sweeps/NAME`, written by `main.py report SWEEP --keep`), so a figure cannot drift from its
 runs, and the runs cannot go missing from a clone."""
 import numpy as np
@@ -17,14 +17,34 @@ def test_the_kept_sweeps_are_in_the_clone():
 
 @pytest.mark.parametrize("name", SWEPT)
 def test_the_readme_quotes_each_kept_sweeps_iqm_and_interval(name):
+    import json
+
+    from rlcore.score_words import return_digits
+
     runs = load_runs(KEPT / name)
-    assert sorted(r["seed"] for r in runs) == [0, 1, 2, 3, 4]
-    iqm, lo, hi = summarize([KEPT / name], reps=5000)["sweeps"][0]["aggregates"]["iqm"]  # as `report`
-    assert readme_iqm_cell(name) == f"{iqm:.1f} [{lo:.1f}, {hi:.1f}]"
+    experiment, model = name.split("__")
+    shipped = json.loads((ROOT / "saved_networks" / experiment / model / "meta.json").read_text())["evaluation"]
+    over = shipped_bar(experiment, model)
+    statistic = over.statistic if over else "iqm"
+    assert sorted(r["seed"] for r in runs) == list(range(over.seeds if over else 5))
+    point, lo, hi = summarize([KEPT / name], reps=5000)["sweeps"][0]["aggregates"][statistic]  # as `report`
+    shown = ((lambda v: f"{v:.0%}") if "success_share" in shipped
+             else (lambda v: f"{v:,.{return_digits(shipped['mean'])}f}"))  # the shipped score's digits
+    name_shown = "IQM" if statistic == "iqm" else statistic
+    assert readme_iqm_cell(name) == f"{name_shown} over {len(runs)}: {shown(point)} [{shown(lo)}, {shown(hi)}]"
+
+
+def shipped_bar(experiment: str, model: str):
+    """The registry's bar over seeds for a shipped model (None where none is set)."""
+    from rlcore.docgen_data import shipped_models
+
+    found = [m for m in shipped_models() if m.folder == f"saved_networks/{experiment}/{model}"]
+    assert len(found) == 1, f"no shipped model in saved_networks/{experiment}/{model}"
+    return found[0].bar.over_seeds if found[0].bar else None
 
 
 def readme_iqm_cell(name: str) -> str:
-    """The "5-seed IQM [95% CI]" cell (the last) of the README row of this sweep's shipped model (the row
+    """The "same recipe over seeds [95% CI]" cell (the last) of the README row of this sweep's shipped model (the row
     that links to its card). The generator writes it (rlcore.docgen); this recomputes it from the runs."""
     experiment, algo = name.split("__")
     card = f"(saved_networks/{experiment}/{algo}/README.md)"
