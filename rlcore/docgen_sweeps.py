@@ -167,7 +167,7 @@ def stop_text(meta: dict, m) -> str:
 
 
 def seed_runs(page: str, experiment: str) -> str:
-    from rlcore.docgen import link, score_text, table
+    from rlcore.docgen import link, over_seeds_bold, score_text, table
 
     parts = []
     for m, runs in _kept_sweeps(experiment):
@@ -182,5 +182,6 @@ def seed_runs(page: str, experiment: str) -> str:
         parts.append(f"**[{m.name}]({link(page, m.sweep.folder + '/report.md')})**, beside the shipped model's "
                      f"{score_text(m)}:\n\n"
                      + table(["seed", "unseen seeds", "further unseen seeds", "env steps", "wall", "env steps/s",
-                              "stopped by"], rows, "rrrrrrl"))
+                              "stopped by"], rows, "rrrrrrl")
+                     + f"\n\nOver the {len(runs)} seeds: {over_seeds_bold(m, '[95% CI] ')}." + seeds_bar_text(m))
     return "\n\n".join([SEED_RUNS_INTRO, *parts]) if parts else ""  # nothing until a sweep is kept

@@ -67,6 +67,9 @@ def test_the_experiment_page_tells_each_kept_sweeps_collapses_as_its_evaluations
     region = page.partition("<!-- generated:sweep-stability")[2].partition("<!-- /generated -->")[0]
     section = region.partition(f"**[{model}](../results/sweeps/{name}/report.md)**: ")[2].partition("\n**[")[0]
     runs = load_runs(KEPT / name)
+    if not any(r["story"].evaluations for r in runs):  # PPO's runs (Mario) evaluate only at their end
+        assert not section or "made no periodic evaluations" in section, section
+        return
     assert section.startswith(stability_summary([r["story"] for r in runs]))
     rows = {line.split("|")[1].strip(): line for line in section.splitlines() if line.startswith("| ")}
     traces = {r["seed"]: critic_trace(r["run_dir"]) for r in runs}
