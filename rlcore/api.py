@@ -193,7 +193,7 @@ def evaluate(model: ModelRef | Policy, episodes: int | None = None, seed_base: i
         meta = shipping.evaluate_into_meta(policy.model_dir, count, seed_base)
         policy.meta = meta
         return dict(meta["evaluation"])
-    summary, line = shipping.run_evaluation(policy.experiment, policy._network, count, seed_base)
+    summary, line = shipping.run_evaluation(policy.experiment, policy._network, count, seed_base, policy.meta)
     return {**summary, "line": line}
 
 

@@ -184,7 +184,7 @@ def cmd_evaluate(args) -> int:
             return 0
         exp, meta, policy = load_policy(model_dir, args.experiment, args.algo)
         episodes = shipping.eval_episodes(exp, args.episodes)
-        _, line = shipping.run_evaluation(exp, policy, episodes, args.seed_base)
+        _, line = shipping.run_evaluation(exp, policy, episodes, args.seed_base, meta)
     print(f"{exp.name} {args.algo} ({name}): {line}")
     return 0
 

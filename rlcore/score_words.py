@@ -4,11 +4,12 @@ reads a meta.json's ``evaluation`` and names only."""
 from __future__ import annotations
 
 
-def success_word(experiment: str, name: str) -> str:
-    """What a successful episode reaches: Mario's flag, or the axe that ends a castle (x-4)."""
+def success_word(experiment: str, name: str, other: str = "success") -> str:
+    """What a successful episode reaches: Mario's flag, or the axe that ends a castle (x-4); ``other``
+    for any other experiment (the console gives its goal's info key)."""
     if experiment == "mario_ppo":
         return "axe" if name.endswith("-4") else "flag"
-    return "success"
+    return other
 
 
 def score_words(evaluation: dict, experiment: str, name: str, plus_minus: str = "±") -> str:

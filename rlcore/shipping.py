@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from rlcore.errors import UserError
-from rlcore.score_words import return_digits, score_words
+from rlcore.score_words import return_digits, score_words, success_word
 
 #: the saved_networks/ of the checkout this package runs from (``python main.py`` or an editable install)
 SAVED_NETWORKS = Path(__file__).resolve().parents[1] / "saved_networks"
@@ -74,15 +74,25 @@ def shipped_summary(folder: Path) -> str:
     return f"shipped: {words} over {ev['episodes']} episodes"
 
 
+def model_name(exp, meta: dict | None) -> str:
+    """A model's name as its shipped folder has it (Mario: its level, ``1-4``), from its meta.json's config;
+    empty for experiments that ship one model per algorithm, or without a meta."""
+    if exp.shipped_by is None or not meta:
+        return ""
+    config = meta.get("config") or {}
+    return "-".join(str(config.get(name, "")) for name in exp.shipped_by.fields)
+
+
 def eval_episodes(exp, requested: int | None) -> int:
     return exp.eval_episodes if requested is None else requested
 
 
-def run_evaluation(exp, policy, episodes: int, seed_base: int | None) -> tuple[dict, str]:
+def run_evaluation(exp, policy, episodes: int, seed_base: int | None, meta: dict | None = None) -> tuple[dict, str]:
     """Evaluate a loaded policy on unseen seeds: ``(summary for meta.json, one-line report)``.
 
     Experiments with a success event (Mario's flag) draw actions from pi with a per-episode seed
-    (their greedy play is one deterministic trajectory); the others play greedily.
+    (their greedy play is one deterministic trajectory); the others play greedily. ``meta``, the model's,
+    names what a success reaches (1-4's axe) as the README does.
     """
     seed_base = exp.eval_seed_base if seed_base is None else seed_base
     seeds = f"{seed_base}..{seed_base + episodes - 1}"
@@ -96,7 +106,8 @@ def run_evaluation(exp, policy, episodes: int, seed_base: int | None) -> tuple[d
         summary = {**summarize_success(records, progress_key), "seeds": seeds,
                    "policy": "sampled from pi, numpy RNG seeded per episode",
                    "per_episode": records}
-        line = (f"{success_key} in {sum(r['success'] for r in records)}/{len(records)} episodes "
+        word = success_word(exp.name, model_name(exp, meta), other=success_key)
+        line = (f"{word} in {sum(r['success'] for r in records)} of {len(records)} episodes "
                 f"({summary['success_share']:.0%}); mean return {summary['mean_return']:.1f}")
         if progress_key:
             line += (f"; {progress_key} mean {summary[f'mean_{progress_key}']:.0f}, "
@@ -143,7 +154,7 @@ def evaluate_into_meta(model_dir: Path, episodes: int, seed_base: int | None = N
     _check_seeds_free(range(seed_base, seed_base + episodes), read_meta(model_dir).get("further_evaluations", []),
                       "a further evaluation")
     exp, meta, policy = load_policy(model_dir, experiment, algo)
-    meta["evaluation"], line = run_evaluation(exp, policy, episodes, seed_base)
+    meta["evaluation"], line = run_evaluation(exp, policy, episodes, seed_base, meta)
     meta["evaluation"]["machine"] = this_machine()  # where these episodes replay exactly (rlcore.machine)
     write_json(model_dir / "meta.json", meta)
     print(f"evaluation (unseen seeds): {line}")
@@ -202,8 +213,8 @@ def evaluate_further_into_meta(model_dir: Path, episodes: int, seed_base: int | 
         raise UserError(f"--seed-base {seed_base} with {episodes} episodes plays seeds {wanted.start}..{wanted.stop - 1}, "
                         f"outside {exp.name}'s unseen range {exp.eval_seed_base}..{exp.selection_seed_base - 1}")
     _check_seeds_free(wanted, recorded, "an evaluation")
-    exp, _, policy = load_policy(model_dir, experiment, algo)
-    summary, line = run_evaluation(exp, policy, episodes, seed_base)
+    exp, loaded, policy = load_policy(model_dir, experiment, algo)
+    summary, line = run_evaluation(exp, policy, episodes, seed_base, loaded)
     summary["machine"] = this_machine()
     _check_seeds_free(wanted, recorded_evaluations(), "an evaluation")  # another process may have recorded some
     meta = read_meta(model_dir)

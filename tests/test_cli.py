@@ -205,6 +205,20 @@ def test_score_words_give_two_decimals_below_100_and_a_castles_axe():
     assert score_words({"success_share": 0.5, "episodes": 30}, "mario_ppo", "1-1") == "flag in 15 of 30"
 
 
+def test_the_evaluate_line_names_a_levels_success_from_the_models_meta():
+    """`evaluate` on a castle says axe, as the README does: the level comes from the model's meta.json."""
+    from rlcore.experiment import get_experiment
+    from rlcore.score_words import success_word
+    from rlcore.shipping import model_name
+
+    mario = get_experiment("mario_ppo")
+    assert model_name(mario, {"config": {"world": 2, "stage": 4}}) == "2-4"
+    assert success_word("mario_ppo", model_name(mario, {"config": {"world": 2, "stage": 4}})) == "axe"
+    assert success_word("mario_ppo", model_name(mario, {"config": {"world": 1, "stage": 2}})) == "flag"
+    assert model_name(get_experiment("lunar_lander"), {"config": {"hidden": [64]}}) == ""
+    assert model_name(mario, None) == ""
+
+
 @pytest.mark.parametrize("argv", [[], *([name] for name in main.COMMANDS)])
 def test_every_help_page_prints(capsys, argv):
     """`main.py --help` and each command's --help: exit 0 and a usage line, never a traceback."""
@@ -283,7 +297,7 @@ def test_evaluate_a_mario_level_by_world_and_stage(capsys, tmp_path, monkeypatch
     code, out, err = run(capsys, "evaluate", "mario_ppo", "ppo", "--world", "1", "--stage", "1",
                          "--episodes", "1")
     assert code == 0, err
-    assert "saved_networks/mario_ppo/1-1): flag_get in " in out
+    assert "saved_networks/mario_ppo/1-1): flag in " in out and " of 1 episodes (" in out
 
 
 def test_evaluate_and_render_a_run_in_progress_and_a_finished_run_folder(capsys, tmp_path, monkeypatch):

@@ -93,4 +93,4 @@ def test_a_success_evaluation_counts_its_failures_by_cause():
     # seeds 10-17: the odd ones win; 10, 12, 14, 16 fall after 1, 3, 5, 2 steps: causes 1, 0, 2, 2
     summary, line = run_evaluation(exp, Policy(), episodes=8, seed_base=10)
     assert summary["success_share"] == 0.5 and summary["causes"] == {"bird": 2, "hole": 1, "rock": 1}
-    assert "won in 4/8 episodes" in line and "; cause: bird 2, hole 1, rock 1 (seeds 10..17" in line
+    assert "won in 4 of 8 episodes (50%)" in line and "; cause: bird 2, hole 1, rock 1 (seeds 10..17" in line
