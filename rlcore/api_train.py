@@ -95,7 +95,8 @@ def resume(run: str | os.PathLike[str] | Run, *, episodes: int | None = None, st
     A run stopped by Ctrl-C (``Interrupted``) or a crash goes on from its checkpoint; a finished one goes
     on if given a larger budget (``episodes`` / ``steps``, in all, not more). ``hyperparameters``: rates,
     coefficients and budgets may change (each change is recorded in meta.json's ``command_starts``); what
-    the run is (its env, networks, seed, preset) may not, and saying so raises :class:`UserError`.
+    the run is (its env, networks, seed, preset, the model it started from) may not, and saying so raises
+    :class:`UserError`.
     """
     from rlcore.checkpoint import read_checkpoint_state
     from rlcore.extras import require_experiment
@@ -132,10 +133,11 @@ def _check_budgets(episodes: int | None, steps: int | None, final_eval_episodes:
 
 
 def _overrides(hyperparameters: dict[str, Any], episodes: int | None, steps: int | None) -> dict[str, Any]:
-    """The config fields a call sets: its hyperparameters (lists as tuples) and its budgets."""
+    """The config fields a call sets: its hyperparameters (lists as tuples, paths as strings) and its budgets."""
     from rlcore.run import budget_overrides
 
-    given = {name: tuple(value) if isinstance(value, list) else value for name, value in hyperparameters.items()}
+    given = {name: tuple(value) if isinstance(value, list) else os.fspath(value) if isinstance(value, os.PathLike)
+             else value for name, value in hyperparameters.items()}
     return {**given, **budget_overrides(episodes, steps, given)}
 
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import os
 import typing
 
 from rlcore.allowed import field_values, flag, setting
@@ -111,7 +112,7 @@ def check_same_run(recorded, overrides: dict, env_fields: tuple[str, ...], run_d
     of a defining field with another value than the recorded one is a :class:`UserError`."""
     defines = {f.name: f.metadata.get("defines_run") for f in dataclasses.fields(recorded)}
     for name in defining_fields(recorded, env_fields):
-        if name in overrides and overrides[name] != getattr(recorded, name):
+        if name in overrides and not _same_value(name, overrides[name], getattr(recorded, name)):
             what = defines[name] if isinstance(defines[name], str) else "the env or the networks"
             raise UserError(f"{setting(name, overrides[name])} cannot change on a resume: the run in {run_dir} was recorded with "
                             f"{name} = {_shown(getattr(recorded, name))}, and it defines {what}; start a new run "
@@ -126,9 +127,27 @@ def check_no_inert(cfg, given) -> None:
         raise UserError(f"{flag(name)} does nothing here: {inert[name]}")
 
 
+#: fields that hold a folder: equal when both name the same folder (``./a/``, ``a``, ``/abs/a``)
+PATH_FIELDS = ("init_from",)
+
+
+def as_recorded(recorded, overrides: dict) -> dict:
+    """``overrides`` with each folder that names the recorded one written as it was recorded, so a resume
+    given ``./a/`` for ``a`` changes nothing (nor records a change)."""
+    return {name: getattr(recorded, name) if name in PATH_FIELDS and _same_value(name, value, getattr(recorded, name))
+            else value for name, value in overrides.items()}
+
+
+def _same_value(name: str, given, recorded) -> bool:
+    if given == recorded:
+        return True
+    return bool(name in PATH_FIELDS and given and recorded
+                and os.path.realpath(given) == os.path.realpath(recorded))
+
+
 def _shown(value) -> str:
     if value == "":
-        return "'' (none)"
+        return "(empty)"
     return ",".join(map(str, value)) if isinstance(value, tuple) else str(value)
 
 

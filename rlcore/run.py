@@ -20,7 +20,7 @@ from typing import Callable
 from rlcore.allowed import flag, resume_words, setting
 from rlcore.experiment import get_experiment
 from rlcore.errors import UserError
-from rlcore.hparams import apply_overrides, check_no_inert, check_same_run, from_dict, to_dict
+from rlcore.hparams import apply_overrides, as_recorded, check_no_inert, check_same_run, from_dict, to_dict
 from rlcore.trainers.spec import RunSpec, check_resumable
 
 
@@ -42,6 +42,7 @@ def build_spec(experiment: str, algo: str, *, preset: str | None = None, seed: i
         # the checkpoint's own hyperparameters; budgets, rates and coefficients may be given again,
         # what defines the env or the networks may not
         recorded = from_dict(config_class, state["config"])
+        overrides = as_recorded(recorded, overrides)
         check_same_run(recorded, overrides, exp.env_fields, run_dir)
         spec.config = apply_overrides(recorded, overrides)
         check_no_inert(spec.config, overrides)

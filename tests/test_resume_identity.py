@@ -28,7 +28,6 @@ def fake_run(folder, experiment: str, algo: str, preset: str = "default", seed: 
     ("mario_ppo", "ppo", "--frames", "history"),
     ("mario_ppo", "ppo", "--actions", "complex"),
     ("mario_ppo", "ppo", "--num-envs", "4"),
-    ("mario_ppo", "ppo", "--init-from", "saved_networks/mario_ppo/1-1"),  # recorded, and used only at its start
     ("lunar_lander", "dqn", "--hidden", "32,32"),
     ("lunar_lander", "dueling_ddqn", "--dueling", "false"),
     ("minitaur", "sac", "--obs-norm", "false"),
@@ -81,6 +80,29 @@ def test_resume_refuses_another_seed_or_preset(capsys, tmp_path, argv, words):
     folder = fake_run(tmp_path / "run", "lunar_lander", "dqn")
     code, _, err = run(capsys, "train", "lunar_lander", "dqn", "--resume", str(folder), *argv)
     assert code == 2 and words in err, err
+
+
+def test_resume_refuses_another_init_from_and_takes_its_own_folder_written_another_way(capsys, tmp_path,
+                                                                                          monkeypatch):
+    """init_from is used once, at a run's start, and recorded: another folder on a resume is refused (it was
+    recorded and ignored); the recorded folder in another spelling (absolute, ./, a trailing slash, a Path
+    from Python) is no change at all, and none is recorded."""
+    from rlcore.api_train import _overrides
+    from rlcore.run import build_spec
+    from tests.test_cli import ROOT
+
+    monkeypatch.chdir(ROOT)
+    recorded = "saved_networks/mario_ppo/1-1"
+    folder = fake_run(tmp_path / "run", "mario_ppo", "ppo", init_from=recorded)
+    code, _, err = run(capsys, "train", "mario_ppo", "ppo", "--resume", str(folder), "--init-from",
+                       "saved_networks/mario_ppo/1-2")
+    assert code == 2 and "\n" not in err.strip(), err
+    assert (f"--init-from saved_networks/mario_ppo/1-2 cannot change on a resume: the run in {folder} was recorded "
+            f"with init_from = {recorded}, and it defines the weights the run started from") in err
+    for spelling in (str(ROOT / recorded), "./" + recorded + "/"):
+        spec = build_spec("mario_ppo", "ppo", run_dir=folder, resume=True, overrides={"init_from": spelling})
+        assert (spec.config.init_from, spec.changes) == (recorded, {}), spelling
+    assert _overrides({"init_from": ROOT / recorded}, None, None) == {"init_from": str(ROOT / recorded)}
 
 
 @pytest.mark.parametrize("argv, words", [
