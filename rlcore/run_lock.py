@@ -37,20 +37,7 @@ def hold_run_folder(run_dir: str | os.PathLike) -> Iterator[Path]:
             _held[folder][1] -= 1
         return
     created = not folder.exists()
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-        fd = os.open(folder / LOCK_FILE, os.O_RDWR | os.O_CREAT, 0o644)
-    except OSError as exc:
-        raise UserError(f"run folder {folder}: cannot write there ({exc.strerror or exc})") from None
-    try:
-        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except OSError as exc:
-        holder = os.pread(fd, 32, 0).decode(errors="replace").strip() or "unknown"
-        os.close(fd)
-        if exc.errno not in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
-            raise UserError(f"run folder {folder}: cannot lock it ({exc.strerror})") from None
-        raise RunFolderBusy(f"run folder {folder} is being written by process {holder}; wait for it to end "
-                            f"(or stop it: kill {holder}), then resume it") from None
+    fd = _lock(folder)
     try:
         os.ftruncate(fd, 0)
         os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)  # who holds it, for the message above
@@ -61,6 +48,38 @@ def hold_run_folder(run_dir: str | os.PathLike) -> Iterator[Path]:
         if created:
             _drop_if_unwritten(folder)  # a run that failed before writing anything leaves no folder behind
         os.close(fd)  # closing the descriptor releases the lock
+
+
+def _lock(folder: Path) -> int:
+    """Create the folder if needed and lock its lock file; the descriptor. A lock file removed while we
+    waited for it (its folder was dropped by a run that failed before writing) is locked again anew."""
+    for _ in range(5):
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
+            fd = os.open(folder / LOCK_FILE, os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError as exc:
+            raise UserError(f"run folder {folder}: cannot write there ({exc.strerror or exc})") from None
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError as exc:
+            holder = os.pread(fd, 32, 0).decode(errors="replace").strip() or "unknown"
+            os.close(fd)
+            if exc.errno not in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
+                raise UserError(f"run folder {folder}: cannot lock it ({exc.strerror})") from None
+            raise RunFolderBusy(f"run folder {folder} is being written by process {holder}; wait for it to end "
+                                f"(or stop it: kill {holder}), then resume it") from None
+        if _still_there(fd, folder / LOCK_FILE):
+            return fd
+        os.close(fd)  # we locked a file that is gone from the folder: another process may lock the new one
+    raise UserError(f"run folder {folder}: its lock file keeps being removed; is another program deleting it?")
+
+
+def _still_there(fd: int, path: Path) -> bool:
+    try:
+        here, there = os.fstat(fd), os.stat(path)
+    except OSError:
+        return False
+    return (here.st_dev, here.st_ino) == (there.st_dev, there.st_ino)
 
 
 def _drop_if_unwritten(folder: Path) -> None:

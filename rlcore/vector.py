@@ -17,11 +17,12 @@ point and writes a checkpoint) and then closes the pool, so the workers must sti
 """
 from __future__ import annotations
 
+import contextlib
 import multiprocessing
 import signal
 import time
 import warnings
-from typing import Callable, Sequence
+from typing import Callable, Iterator, Sequence
 
 import gymnasium as gym
 import numpy as np
@@ -170,6 +171,17 @@ class EnvPool:
                     self._terminate_workers()
         else:
             self.envs.close()
+
+    @contextlib.contextmanager
+    def closed_on_error(self) -> Iterator[EnvPool]:
+        """For a run's set-up between starting the pool and its ``with`` block (building the agent, loading
+        a checkpoint or an ``--init-from`` model): an error there closes the workers first, politely, so
+        they leave without a traceback of their own and only the error's one line is said."""
+        try:
+            yield self
+        except BaseException:
+            self.close()
+            raise
 
     def __enter__(self):
         return self

@@ -25,26 +25,27 @@ def train(spec: RunSpec) -> Path:
     keras.utils.set_random_seed(spec.seed)
     make_env = partial(spec.experiment.make_env, max_episode_steps=cfg.max_episode_steps or None)
     envs = EnvPool([make_env] * cfg.num_envs, mode=cfg.vec)
-    obs_dim, n_actions = envs.single_observation_space.shape[0], int(envs.single_action_space.n)
-    agent = A2CAgent(obs_dim, n_actions, cfg)
-    rng = np.random.default_rng(spec.seed)
+    with envs.closed_on_error():  # a start that fails (a damaged checkpoint, say) ends them quietly
+        obs_dim, n_actions = envs.single_observation_space.shape[0], int(envs.single_action_space.n)
+        agent = A2CAgent(obs_dim, n_actions, cfg)
+        rng = np.random.default_rng(spec.seed)
 
-    state, arrays = checkpoints.restore(spec, agent, rng)
-    session = TrainingSession(spec, state, resumed_arrays=arrays)
+        state, arrays = checkpoints.restore(spec, agent, rng)
+        session = TrainingSession(spec, state, resumed_arrays=arrays)
 
-    def checkpoint():
-        checkpoints.save(session, agent, rng)
+        def checkpoint():
+            checkpoints.save(session, agent, rng)
 
-    t, n = cfg.n_steps, cfg.num_envs
-    buf_obs = np.zeros((t, n, obs_dim), np.float32)
-    buf_next = np.zeros((t, n, obs_dim), np.float32)
-    buf_actions = np.zeros((t, n), np.int32)
-    buf_rewards, buf_term, buf_done = (np.zeros((t, n), np.float32) for _ in range(3))
-    running = np.zeros(n)
-    losses = {"actor_loss": float("nan"), "critic_loss": float("nan"), "entropy": float("nan")}
-    # a resumed run starts fresh episodes, reseeded from its episode count
-    obs, _ = envs.reset(seed=session.fresh_env_seeds(n))
-    next_checkpoint = (session.book.episodes // cfg.checkpoint_every + 1) * cfg.checkpoint_every
+        t, n = cfg.n_steps, cfg.num_envs
+        buf_obs = np.zeros((t, n, obs_dim), np.float32)
+        buf_next = np.zeros((t, n, obs_dim), np.float32)
+        buf_actions = np.zeros((t, n), np.int32)
+        buf_rewards, buf_term, buf_done = (np.zeros((t, n), np.float32) for _ in range(3))
+        running = np.zeros(n)
+        losses = {"actor_loss": float("nan"), "critic_loss": float("nan"), "entropy": float("nan")}
+        # a resumed run starts fresh episodes, reseeded from its episode count
+        obs, _ = envs.reset(seed=session.fresh_env_seeds(n))
+        next_checkpoint = (session.book.episodes // cfg.checkpoint_every + 1) * cfg.checkpoint_every
     with envs, session.interruptible():
         while not session.should_stop():
             for step in range(t):

@@ -61,7 +61,7 @@ def train(spec: RunSpec) -> Path:
     keras.utils.set_random_seed(spec.seed)
     make_env = exp.training_env_factory(cfg)
     envs = EnvPool([make_env] * cfg.num_envs, mode=cfg.vec)
-    try:  # a start that fails (a wrong --init-from model, say) closes the env processes, then says why
+    with envs.closed_on_error():  # a start that fails (a wrong --init-from model, say) ends them quietly
         obs_shape, n_actions = envs.single_observation_space.shape, int(envs.single_action_space.n)
         agent = PPOAgent(obs_shape, n_actions, cfg)
         if note := bfloat16_note(cfg.precision, cpu_flags()):
@@ -94,9 +94,6 @@ def train(spec: RunSpec) -> Path:
         losses = {name: float("nan") for name in UPDATE_NAMES}  # CSV columns exist from the first row
         # a resumed run starts fresh episodes, reseeded from its episode count
         obs, _ = envs.reset(seed=session.fresh_env_seeds(n))
-    except BaseException:
-        envs.close()
-        raise
     with envs, session.interruptible():
         while not session.should_stop():
             log = RolloutLog(exp)
