@@ -38,9 +38,12 @@ def init_from_meta(folder: str | Path, experiment: str, algo: str) -> dict:
         meta = read_meta(folder)
     except UserError as exc:
         raise UserError(f"{flag('init_from')}: {exc}") from None
-    if (meta.get("experiment"), meta.get("algo")) != (experiment, algo):
-        held = " ".join(str(meta[key]) for key in ("experiment", "algo") if meta.get(key)) or "no named"
-        raise UserError(f"{setting('init_from', str(folder))} holds a {held} model, not {experiment} {algo}")
+    if not (meta.get("experiment") and meta.get("algo")):
+        raise UserError(f"{setting('init_from', str(folder))}: its meta.json does not say which experiment and "
+                        f"algorithm its model is for (a {experiment} {algo} model is needed)")
+    if (meta["experiment"], meta["algo"]) != (experiment, algo):
+        raise UserError(f"{setting('init_from', str(folder))} holds a {meta['experiment']} {meta['algo']} model, "
+                        f"not {experiment} {algo}")
     network = Path(folder) / POLICY_FILES[get_experiment(experiment).algo(algo).kind]
     if not network.is_file():
         raise UserError(f"{setting('init_from', str(folder))} has a meta.json but no {network.name}: copy the "

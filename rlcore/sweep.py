@@ -126,7 +126,7 @@ def parse_grid(items: list[str], config) -> dict[str, list]:
             raise UserError(f"--grid {item!r}: {name!r} is not a hyperparameter of {type(config).__name__}; "
                             f"`main.py train EXPERIMENT ALGO --help` lists them")
         if name in UNSWEPT:
-            raise UserError(f"--grid {item!r}: a sweep cannot vary {name} ({UNSWEPT[name]})")
+            raise UserError(f"--grid {item!r}: a sweep cannot set {name} ({UNSWEPT[name]})")
         try:
             # tuple fields (hidden sizes) take ';' between values: --grid hidden=64,64;128,128
             sep_values = values.split(";") if isinstance(getattr(config, name), tuple) else values.split(",")

@@ -62,7 +62,7 @@ def test_seeds_and_grid_parsing():
     (["sweep", "lunar_lander", "dqn", "--grid", "keep_best=maybe"], "--grid 'keep_best=maybe' is invalid: 'maybe'"),
     (["sweep", "lunar_lander", "dqn", "--seeds", "4-x"], "--seeds '4-x' is invalid"),
     (["sweep", "mario_ppo", "ppo", "--grid", "init_from=saved_networks/mario_ppo/1-1"],
-     "a sweep cannot vary init_from"),
+     "a sweep cannot set init_from"),
     (["sweep", "lunar_lander", "dqn", "--seeds", "4-0"], "the range 4-0 runs downward; write 0-4"),
     (["report", "/nonexistent/sweep"], "no sweep folder /nonexistent/sweep"),
     (["sweep", "lunar_lander", "dqn", "--name", "../x"], "argument --name: '../x' is invalid: give a folder name"),

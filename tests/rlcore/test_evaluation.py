@@ -1,11 +1,13 @@
 """The greedy evaluation's per-episode records: seed order, lengths, time limit against a fall,
 final info values, and the summary that goes into meta.json."""
+import dataclasses
+
 import gymnasium as gym
 import numpy as np
 import pytest
 
 from rlcore.evaluation import evaluate, evaluate_success, play_greedy
-from rlcore.experiment import Experiment, Goal
+from rlcore.experiment import Experiment, Goal, ShippedBy
 from rlcore.shipping import run_evaluation
 
 LIMIT = 6
@@ -93,4 +95,9 @@ def test_a_success_evaluation_counts_its_failures_by_cause():
     # seeds 10-17: the odd ones win; 10, 12, 14, 16 fall after 1, 3, 5, 2 steps: causes 1, 0, 2, 2
     summary, line = run_evaluation(exp, Policy(), episodes=8, seed_base=10)
     assert summary["success_share"] == 0.5 and summary["causes"] == {"bird": 2, "hole": 1, "rock": 1}
-    assert "won in 4 of 8 episodes (50%)" in line and "; cause: bird 2, hole 1, rock 1 (seeds 10..17" in line
+    assert "won in 4 of 8 episodes (50%)" in line
+    # an experiment that ships one model per level names a success by the model's level, as the README does
+    castle = dataclasses.replace(exp, name="mario_ppo", shipped_by=ShippedBy(("world", "stage"), "1-1"))
+    for stage, word in ((4, "axe"), (1, "flag")):
+        _, line = run_evaluation(castle, Policy(), episodes=8, seed_base=10, meta={"config": {"world": 2, "stage": stage}})
+        assert line.startswith(f"{word} in 4 of 8 episodes (50%)"), line and "; cause: bird 2, hole 1, rock 1 (seeds 10..17" in line
