@@ -59,3 +59,36 @@ def test_a_process_may_reenter_its_own_lock_and_another_may_not(tmp_path):
         assert other.returncode != 0 and "RunFolderBusy" in other.stderr
     with hold_run_folder(tmp_path / "run"):  # released at the end of the block: taken again
         pass
+
+
+def test_a_folder_made_for_a_run_that_wrote_nothing_goes_and_a_given_one_stays(tmp_path):
+    """A run that fails before writing anything leaves no folder holding only .lock; a folder that existed
+    before (a user's, or a resumed run's) stays, and so does one the run wrote into."""
+    with hold_run_folder(tmp_path / "new"):
+        pass
+    assert not (tmp_path / "new").exists()
+    (tmp_path / "given").mkdir()
+    with hold_run_folder(tmp_path / "given"):
+        pass
+    assert (tmp_path / "given").is_dir()
+    with hold_run_folder(tmp_path / "wrote") as folder:
+        (folder / "metrics.csv").write_text("episode\n")
+    assert (tmp_path / "wrote" / "metrics.csv").is_file()
+
+
+def test_a_lock_on_a_lock_file_removed_meanwhile_is_not_held(tmp_path):
+    """Taking a lock on a lock file another process removed (its folder dropped) would let a third process
+    lock the new file too: the lock checks that its file is still the folder's, and takes the new one."""
+    import os
+
+    from rlcore.run_lock import _lock, _still_there
+
+    folder = tmp_path / "run"
+    fd = _lock(folder)
+    assert _still_there(fd, folder / ".lock")
+    (folder / ".lock").unlink()
+    assert not _still_there(fd, folder / ".lock")
+    again = _lock(folder)  # the old descriptor still locks the removed file: the new one is free
+    assert _still_there(again, folder / ".lock")
+    os.close(fd)
+    os.close(again)
