@@ -2,7 +2,7 @@
 
 First what the run is and how far it got, with the pace of a run in progress and the hours left at that
 pace to its env-step budget (:func:`pace`), and where it was resumed and what each resume changed
-(:func:`resumes_lines`). Then, for a run that lasts many sessions (a Mario level): per block of
+(:func:`resumes_lines`), and where a success-share stop rule stands (:func:`goal_line`). Then, for a run that lasts many sessions (a Mario level): per block of
 episodes that started where evaluations start, the success share, the mean progress and the mean
 return; the episodes that started elsewhere (Mario's restarts) beside them, with where they started;
 and what ended the failures. For a run without a goal (Minitaur): per block, the mean return, episode length and info
@@ -32,7 +32,8 @@ def run_status(run_dir: str | Path, experiment, about: dict, block: int = 200,
     ``blocks`` blocks of ``rollout_block`` rollouts, then the last periodic evaluations."""
     df = read_table(Path(run_dir) / "metrics.csv", "episode", "env_steps", "total_points")
     pace = pace_text(Path(run_dir) / "metrics.csv", about) if "returns" in about else None  # a checkpoint's
-    lines = [headline(about) + (f"; {pace}" if pace else "")] + resumes_lines(about)
+    goal = goal_line(about, experiment) if "returns" in about else None
+    lines = [headline(about) + (f"; {pace}" if pace else "")] + resumes_lines(about) + ([goal] if goal else [])
     full = full_episodes(df, experiment.curriculum.partial_key if experiment.curriculum else None)
     recent = full.tail(block * blocks)
     if recent.empty:
@@ -56,6 +57,20 @@ def headline(about: dict) -> str:
     if "stopped_by" in about:
         text += f"; stopped by {about['stopped_by']}"
     return text
+
+
+def goal_line(about: dict, experiment) -> str | None:
+    """Where a run's success-share stop rule stands (``--stop-success-share``): ``stops once flag_get comes
+    in 90% of the last 100 episodes from the start: now 57 of 100 (57%)``; None without one."""
+    config = about.get("config") or {}
+    share, window = config.get("stop_success_share") or 0.0, config.get("window") or 0
+    if not (share and window):
+        return None
+    recent = list(about.get("successes") or [])[-window:]  # counted episodes only, as the rule reads them
+    word = experiment.goal.success_key if experiment.goal else "success"
+    now = (f"now {sum(map(bool, recent))} of {len(recent)} ({np.mean(recent):.0%})" if len(recent) >= window
+           else f"{len(recent)} of those {window} episodes so far")
+    return f"stops once {word} comes in {share:.0%} of the last {window} episodes from the start: {now}"
 
 
 def resumes_lines(about: dict, most: int = 6) -> list[str]:

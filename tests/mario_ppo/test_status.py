@@ -94,3 +94,24 @@ def test_status_shows_blocks_of_rollouts_with_update_sizes_and_the_learning_rate
     # rollouts 1-2 predate the entropy_coef column (empty): the first block shows the one value it has
     assert lines[0].endswith("| lr 0.0001, entropy weight 0.003")
     assert lines[1].endswith("| lr 0.0001 -> 5e-05, entropy weight 0.003")
+
+
+def test_status_says_where_the_success_share_stop_rule_stands(capsys, tmp_path):
+    """A run stopped by --stop-success-share: the flags of the last `window` counted episodes against it,
+    and before the window is full, how many of it have been played."""
+    from rlcore.checkpoint import save_checkpoint
+
+    rows = [HEADER] + [f"{i},10,0,0,{100 * i},20,{int(i % 4 == 0)},0,0," for i in range(1, 31)]
+    (tmp_path / "metrics.csv").write_text("\n".join(rows) + "\n")
+    for successes, words in (([i % 4 == 0 for i in range(1, 31)], "now 5 of 20 (25%)"),
+                             ([True] * 12, "12 of those 20 episodes so far")):
+        save_checkpoint(tmp_path / "checkpoint.npz", {}, {}, {
+            "experiment": "mario_ppo", "algo": "ppo", "preset": "default", "seed": 0, "env_steps": 3000,
+            "config": {"window": 20, "stop_success_share": 0.9}, "returns": [10.0] * 30, "successes": successes,
+            "wall_seconds": 60.0})
+        lines = status_lines(capsys, tmp_path)
+        assert lines[1] == f"stops once flag_get comes in 90% of the last 20 episodes from the start: {words}"
+    save_checkpoint(tmp_path / "checkpoint.npz", {}, {}, {
+        "experiment": "mario_ppo", "algo": "ppo", "preset": "default", "seed": 0, "env_steps": 3000,
+        "config": {"window": 20, "stop_success_share": 0.0}, "returns": [10.0] * 30, "wall_seconds": 60.0})
+    assert not any(line.startswith("stops once") for line in status_lines(capsys, tmp_path))
