@@ -203,9 +203,12 @@ def whole_number(allowed: Allowed):
     return parse
 
 
-def check_whole(name: str, value, allowed: Allowed) -> None:
+def check_whole(name: str, value, allowed: Allowed, none_ok: bool = False) -> None:
     """A whole-number argument of the Python API (``seed=``, ``episodes=`` ...), checked as
-    :func:`whole_number` checks it on the command line: :class:`UserError` naming it otherwise."""
+    :func:`whole_number` checks it on the command line: :class:`UserError` naming it otherwise.
+    ``none_ok``: None (the default's stand-in) passes."""
+    if value is None and none_ok:
+        return
     try:
         number = None if isinstance(value, bool) else operator.index(value)  # int, numpy integers
     except TypeError:

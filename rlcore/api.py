@@ -30,8 +30,9 @@ from typing import TYPE_CHECKING, Any, Iterator, Literal, Union
 os.environ.setdefault("TF_CPP_MIN_LOG_LEVEL", "2")  # before anything imports TensorFlow, as main.py does
 import numpy as np
 
-from rlcore.allowed import named_as_python
+from rlcore.allowed import NON_NEGATIVE, check_whole, named_as_python
 from rlcore.api_train import ProgressCallback, Run, WandbMode, resume, train
+from rlcore.command_line import EVAL_COUNT, FRAME_RATE
 from rlcore.errors import UserError
 from rlcore.experiment import Experiment
 from rlcore.trainers.stopping import Interrupted
@@ -169,28 +170,29 @@ def load(model: ModelRef | Policy) -> Policy:
 # ---------------------------------------------------------------------- evaluate, render
 @named_as_python
 def evaluate(model: ModelRef | Policy, episodes: int | None = None, seed_base: int | None = None,
-             record: bool = False, record_further: bool = False) -> dict[str, Any]:
+             record: bool = False, record_further: bool = False, replace: bool = False) -> dict[str, Any]:
     """Evaluate on unseen seeds as ``main.py evaluate`` does (episode i seeded ``seed_base + i``,
     default the experiment's evaluation range; ``episodes`` default 100, Mario 10): greedy
     mean/std/min of the return and per-episode records, or for Mario the share of episodes that
     reached the flag. ``line`` holds the one-line report. ``record``: also write it into the model
-    folder's meta.json as its evaluation. ``record_further``: add it to meta.json's
-    ``further_evaluations`` instead, on unseen seeds no recorded evaluation played (by default those
-    right after the last ones recorded), the evaluation kept."""
+    folder's meta.json as its evaluation (one recorded already is replaced only with ``replace``).
+    ``record_further``: add it to meta.json's ``further_evaluations`` instead, on unseen seeds no
+    recorded evaluation played (by default those right after the last ones recorded), the evaluation
+    kept."""
     from rlcore import shipping
 
     if record and record_further:
         raise UserError("give record (the model's evaluation) or record_further (one more), not both")
+    check_whole("episodes", episodes, EVAL_COUNT, none_ok=True)
+    check_whole("seed_base", seed_base, NON_NEGATIVE, none_ok=True)
     policy = load(model)
     count = shipping.eval_episodes(policy.experiment, episodes)
-    if count < 1:
-        raise UserError(f"episodes must be at least 1, not {count}")
     if record_further:
         meta = shipping.evaluate_further_into_meta(policy.model_dir, count, seed_base)
         policy.meta = meta
         return dict(meta["further_evaluations"][-1])
     if record:
-        meta = shipping.evaluate_into_meta(policy.model_dir, count, seed_base)
+        meta = shipping.evaluate_into_meta(policy.model_dir, count, seed_base, replace=replace)
         policy.meta = meta
         return dict(meta["evaluation"])
     summary, line = shipping.run_evaluation(policy.experiment, policy._network, count, seed_base, policy.meta)
@@ -207,6 +209,9 @@ def render(model: ModelRef | Policy, out: str | os.PathLike[str] = "video.mp4", 
     from rlcore.video import check_video_path
 
     path = check_video_path(Path(out))
+    check_whole("episodes", episodes, EVAL_COUNT, none_ok=True)
+    check_whole("seed", seed, NON_NEGATIVE, none_ok=True)
+    check_whole("fps", fps, FRAME_RATE, none_ok=True)
     policy = load(model)
     writable_folder(path.parent, "out")
     render_policy(policy, path, fps, episodes, seed)

@@ -80,17 +80,18 @@ def train(env: str, algo: str, *, preset: str | None = None, seed: int = 0,
                                                  steps=steps, final_eval_episodes=final_eval_episodes,
                                                  **hyperparameters))
     spec = build_spec(env, algo, preset=preset, seed=seed, overrides=overrides, run_dir=folder,
-                      wandb_mode=wandb, progress=progress, command=command)
+                      wandb_mode=wandb, progress=progress, command=command, final_eval_episodes=final_eval_episodes)
     return _train_and_evaluate(spec, f"training {env} {algo} ({spec.preset} preset, seed {spec.seed}) -> {folder}",
-                               final_eval_episodes, callback, progress)
+                               callback, progress)
 
 
 @named_as_python
 def resume(run: str | os.PathLike[str] | Run, *, episodes: int | None = None, steps: int | None = None,
-           final_eval_episodes: int | None = None, wandb: WandbMode = "off", progress: bool = True,
+           final_eval_episodes: int | None = None, wandb: WandbMode | None = None, progress: bool = True,
            callback: ProgressCallback | None = None, **hyperparameters: Any) -> Run:
     """Continue the run in ``run`` (its folder, or a :class:`Run`) from its last checkpoint, as ``main.py
     train ENV ALGO --resume RUN_DIR`` does, and evaluate it; return the :class:`Run`.
+    ``final_eval_episodes`` and ``wandb`` left None: as the run had them.
 
     A run stopped by Ctrl-C (``Interrupted``) or a crash goes on from its checkpoint; a finished one goes
     on if given a larger budget (``episodes`` / ``steps``, in all, not more). ``hyperparameters``: rates,
@@ -117,10 +118,10 @@ def resume(run: str | os.PathLike[str] | Run, *, episodes: int | None = None, st
     command = _call("resume", [str(folder)], dict(episodes=episodes, steps=steps,
                                                   final_eval_episodes=final_eval_episodes, **hyperparameters))
     spec = build_spec(env, algo, overrides=_overrides(hyperparameters, episodes, steps), run_dir=folder,
-                      resume=True, wandb_mode=wandb, progress=progress, command=command)
+                      resume=True, wandb_mode=wandb, progress=progress, command=command,
+                      final_eval_episodes=final_eval_episodes)
     return _train_and_evaluate(spec, f"resuming {folder} at episode {len(state['returns'])}, env step "
-                                     f"{state['env_steps']}{resuming_changes(spec.changes)}", final_eval_episodes,
-                               callback, progress)
+                                     f"{state['env_steps']}{resuming_changes(spec.changes)}", callback, progress)
 
 
 def _check_budgets(episodes: int | None, steps: int | None, final_eval_episodes: int | None) -> None:
@@ -141,14 +142,13 @@ def _overrides(hyperparameters: dict[str, Any], episodes: int | None, steps: int
     return {**given, **budget_overrides(episodes, steps, given)}
 
 
-def _train_and_evaluate(spec: Any, first_line: str, final_eval_episodes: int | None,
-                        callback: ProgressCallback | None, progress: bool) -> Run:
+def _train_and_evaluate(spec: Any, first_line: str, callback: ProgressCallback | None, progress: bool) -> Run:
     from rlcore.run import train_and_evaluate
 
     say: Callable[[str], None] = print if progress else (lambda line: None)
     say(first_line)
     with _quiet_unless(progress):
-        model_dir, meta = train_and_evaluate(spec, final_eval_episodes, on_progress=callback, say=say)
+        model_dir, meta = train_and_evaluate(spec, on_progress=callback, say=say)
     return Run(spec.run_dir, model_dir, meta)
 
 

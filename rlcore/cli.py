@@ -58,7 +58,8 @@ def _spec_from_args(args):
     given = overrides_from_args(args)
     overrides = {**given, **_budget_overrides(args, given)}
     common = dict(preset=args.preset, seed=args.seed, overrides=overrides, wandb_mode=args.wandb,
-                  progress=not args.no_progress, command=getattr(args, "command_line", None))
+                  progress=not args.no_progress, command=getattr(args, "command_line", None),
+                  final_eval_episodes=args.final_eval_episodes)
     if args.resume is not None:
         run_dir = latest_run_dir(args.experiment, args.algo) if args.resume == "latest" else Path(args.resume)
         spec = build_spec(args.experiment, args.algo, run_dir=run_dir, resume=True,
@@ -78,12 +79,14 @@ def cmd_train(args) -> int:
     from rlcore.trainers.spec import folder_safe
 
     spec = _spec_from_args(args)
-    if args.publish and args.final_eval_episodes is not None and args.final_eval_episodes < spec.experiment.eval_episodes:
+    final = spec.final_eval_episodes  # given, or on a resume the run's
+    if args.publish and final is not None and final < spec.experiment.eval_episodes:
+        given = "" if args.final_eval_episodes is not None else " (the run's; give it again to change it)"
         raise UserError(f"--publish needs the evaluation a shipped model has ({spec.experiment.eval_episodes} episodes "
-                        f"on unseen seeds), not --final-eval-episodes {args.final_eval_episodes}")
+                        f"on unseen seeds), not --final-eval-episodes {final}{given}")
     print(f"training {spec.experiment.name} {spec.algo} ({spec.preset} preset, seed {spec.seed}) "
           f"-> {spec.run_dir}")
-    model_dir, meta = train_and_evaluate(spec, args.final_eval_episodes)
+    model_dir, meta = train_and_evaluate(spec)
     print(f"model:   {model_dir}/")
     print(f"plot:    {model_dir / meta['plot']}")
     print(f"metrics: {model_dir / 'metrics.csv'}")
@@ -175,11 +178,14 @@ def cmd_evaluate(args) -> int:
 
     if args.record and args.record_further:
         raise UserError("give --record (the model's evaluation) or --record-further (one more), not both")
+    if args.replace and not args.record:
+        raise UserError("--replace goes with --record (it lets the new evaluation overwrite the recorded one)")
     with _model(args) as (model_dir, name):
         if args.record or args.record_further:  # seeds checked before the model loads; it must match the names
             record = shipping.evaluate_further_into_meta if args.record_further else shipping.evaluate_into_meta
             episodes = shipping.eval_episodes(shipping.experiment_of(model_dir), args.episodes)
-            record(model_dir, episodes, args.seed_base, args.experiment, args.algo)
+            extra = {} if args.record_further else {"replace": args.replace}
+            record(model_dir, episodes, args.seed_base, args.experiment, args.algo, **extra)
             print(f"recorded in {model_dir / 'meta.json'}" + (" (further_evaluations)" if args.record_further else ""))
             return 0
         exp, meta, policy = load_policy(model_dir, args.experiment, args.algo)

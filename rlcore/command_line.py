@@ -66,7 +66,9 @@ COUNT, NON_NEGATIVE = whole_number(allowed.COUNT), whole_number(allowed.NON_NEGA
 RUN_SEEDS = Allowed(low=0, high=MAX_RUN_SEED)
 FINAL_EVALUATION = Allowed(low=0, high=MAX_EVAL_EPISODES)  # one unseen seed per episode; 0 = none
 SEED = whole_number(RUN_SEEDS)
-EVAL_EPISODES = whole_number(Allowed(low=1, high=MAX_EVAL_EPISODES))
+EVAL_COUNT = Allowed(low=1, high=MAX_EVAL_EPISODES)  # evaluate's and render's --episodes
+FRAME_RATE = Allowed(low=1, high=240)  # render's --fps
+EVAL_EPISODES = whole_number(EVAL_COUNT)
 FINAL_EVAL_EPISODES = whole_number(FINAL_EVALUATION)
 
 
@@ -134,14 +136,14 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
     train.add_argument("--seed", type=SEED, default=None,
                        help=f"0 to {MAX_RUN_SEED}: seeds numpy, TensorFlow and the envs (default 0); each run "
                             "seed owns its own training env seeds, all below the evaluation seeds")
-    train.add_argument("--wandb", default="auto", choices=["auto", "online", "offline", "off"],
-                       help="auto = online when logged in, else offline (default auto)")
+    train.add_argument("--wandb", default=None, choices=["auto", "online", "offline", "off"],
+                       help="auto = online when logged in, else offline (default auto; a resume: the run's)")
     train.add_argument("--resume", nargs="?", const="latest", default=None, metavar="RUN_DIR",
                        help="continue a run from its checkpoint (default: the latest run of this algo)")
     train.add_argument("--run-dir", default=None, help="where the run writes (default runs/<name>)")
     train.add_argument("--final-eval-episodes", type=FINAL_EVAL_EPISODES, default=None,
                        help="evaluation episodes after training, on unseen seeds "
-                            "(default 100; Mario 10; 0 = none)")
+                            "(default 100; Mario 10; 0 = none; a resume: the run's)")
     train.add_argument("--video", action="store_true", help="also render an MP4 of the trained agent")
     train.add_argument("--publish", action="store_true",
                        help="copy the trained model into saved_networks/EXPERIMENT/ALGO/, replacing the "
@@ -159,7 +161,10 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
             p.add_argument("--seed-base", type=NON_NEGATIVE, default=None,
                            help="episode i uses seed SEED_BASE+i (default: the experiment's unseen range)")
             p.add_argument("--record", action="store_true",
-                           help="write the result into the model folder's meta.json as its evaluation")
+                           help="write the result into the model folder's meta.json as its evaluation "
+                                "(refused if it records one, unless --replace)")
+            p.add_argument("--replace", action="store_true",
+                           help="with --record: overwrite the evaluation meta.json records")
             p.add_argument("--record-further", action="store_true",
                            help="add the result to the model folder's meta.json as a further evaluation on other "
                                 "unseen seeds, its evaluation kept; by default on the seeds right after the last "
@@ -168,7 +173,7 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
             p.add_argument("--out", default=None,
                            help="an .mp4 or a .gif path (a GIF: ~320 px wide, every few frames, looping), "
                                 "or a folder for an MP4 (default videos/EXPERIMENT_ALGO.mp4)")
-            p.add_argument("--fps", type=whole_number(Allowed(low=1, high=240)), default=None,
+            p.add_argument("--fps", type=whole_number(FRAME_RATE), default=None,
                            help="frames per second (default: experiment's)")
             p.add_argument("--episodes", type=EVAL_EPISODES, default=None, help="default 1; Minitaur 3")
             p.add_argument("--seed", type=NON_NEGATIVE, default=None,

@@ -26,18 +26,24 @@ from rlcore.trainers.spec import RunSpec, check_resumable
 
 def build_spec(experiment: str, algo: str, *, preset: str | None = None, seed: int | None = None,
                overrides: dict | None = None, run_dir: Path, resume: bool = False,
-               wandb_mode: str = "auto", progress: bool = True, command: str | None = None,
-               nothing_to_train_ok: bool = False) -> RunSpec:
+               wandb_mode: str | None = None, progress: bool = True, command: str | None = None,
+               nothing_to_train_ok: bool = False, final_eval_episodes: int | None = None) -> RunSpec:
     """The :class:`RunSpec` of a new run (``resume=False``; ``seed`` None = 0) or of the run in
     ``run_dir``, whose seed, preset and defining fields a resume may not change, and which must have
-    something left to train unless ``nothing_to_train_ok`` (``--publish``: evaluate it again, publish)."""
+    something left to train unless ``nothing_to_train_ok`` (``--publish``: evaluate it again, publish).
+    ``wandb_mode`` and ``final_eval_episodes`` left None: ``auto`` and the experiment's default for a new
+    run, the run's own for a resume (its checkpoint records them)."""
     exp = get_experiment(experiment)
     overrides = dict(overrides or {})
     extra = {} if command is None else {"command": command}
     if resume:
-        spec = RunSpec(exp, algo, preset or "", None, seed, wandb_mode, Path(run_dir), True,
-                       progress=progress, **extra)
+        spec = RunSpec(exp, algo, preset or "", None, seed, wandb_mode or "auto", Path(run_dir), True,
+                       progress=progress, final_eval_episodes=final_eval_episodes, **extra)
         state = check_resumable(spec)
+        if wandb_mode is None:
+            spec.wandb_mode = str(state.get("wandb_mode") or "auto")
+        if final_eval_episodes is None and state.get("final_eval_episodes") is not None:
+            spec.final_eval_episodes = int(state["final_eval_episodes"])
         config_class = type(exp.preset(algo, None))
         # the checkpoint's own hyperparameters; budgets, rates and coefficients may be given again,
         # what defines the env or the networks may not
@@ -65,8 +71,8 @@ def build_spec(experiment: str, algo: str, *, preset: str | None = None, seed: i
 
         init_from_meta(config.init_from, exp.name, algo)
     seed = 0 if seed is None else seed
-    return RunSpec(exp, algo, preset or exp.algo(algo).default_preset, config, seed, wandb_mode,
-                   Path(run_dir), progress=progress, **extra)
+    return RunSpec(exp, algo, preset or exp.algo(algo).default_preset, config, seed, wandb_mode or "auto",
+                   Path(run_dir), progress=progress, final_eval_episodes=final_eval_episodes, **extra)
 
 
 def refuse_nothing_to_train(spec: RunSpec, state: dict) -> None:
@@ -151,11 +157,10 @@ def check_new_run_dir(run_dir: Path) -> None:
                         f"{resume_words(run_dir)}, or give another {flag('run_dir')}")
 
 
-def train_and_evaluate(spec: RunSpec, final_eval_episodes: int | None = None,
-                       on_progress: Callable[[dict, str], None] | None = None,
+def train_and_evaluate(spec: RunSpec, on_progress: Callable[[dict, str], None] | None = None,
                        say: Callable[[str], None] = print) -> tuple[Path, dict]:
     """What ``main.py train`` and :func:`rlcore.api.train` both run: :func:`run_training`, then the
-    final evaluation on unseen seeds recorded in meta.json (``final_eval_episodes``: None = the
+    final evaluation on unseen seeds recorded in meta.json (``spec.final_eval_episodes``: None = the
     experiment's default, 0 = none). Returns the model folder and its meta.json."""
     import json
 
@@ -165,7 +170,7 @@ def train_and_evaluate(spec: RunSpec, final_eval_episodes: int | None = None,
     meta = json.loads((model_dir / "meta.json").read_text())
     say(f"trained: {meta['episodes']} episodes, {meta['env_steps']} env steps, "
         f"{meta['wall_seconds']:.0f} s; last-100 average {meta['final_average']:.1f}")
-    episodes = shipping.eval_episodes(spec.experiment, final_eval_episodes)
+    episodes = shipping.eval_episodes(spec.experiment, spec.final_eval_episodes)
     if episodes > 0:
-        meta = shipping.evaluate_into_meta(model_dir, episodes)
+        meta = shipping.evaluate_into_meta(model_dir, episodes, replace=True)  # the model just trained
     return model_dir, meta

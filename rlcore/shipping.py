@@ -141,17 +141,21 @@ def run_evaluation(exp, policy, episodes: int, seed_base: int | None, meta: dict
 
 
 def evaluate_into_meta(model_dir: Path, episodes: int, seed_base: int | None = None,
-                       experiment: str | None = None, algo: str | None = None) -> dict:
+                       experiment: str | None = None, algo: str | None = None, replace: bool = False) -> dict:
     """Evaluate a model on unseen seeds and write the result into its meta.json as its ``evaluation``.
-    Refused when those seeds overlap a further evaluation already recorded (it would no longer be held
-    out)."""
+    Refused when it records one already, unless ``replace`` (a shipped model's 100 episodes are not
+    overwritten by a 1-episode try), and when those seeds overlap a further evaluation already recorded
+    (it would no longer be held out)."""
     from rlcore.atomic import write_json
     from rlcore.machine import this_machine
     from rlcore.policies import load_policy, read_meta
 
     exp = experiment_of(model_dir)
+    recorded = read_meta(model_dir)
+    if recorded.get("evaluation") and not replace:
+        raise UserError(_replace_refusal(model_dir, recorded["evaluation"], exp, recorded))
     seed_base = exp.eval_seed_base if seed_base is None else seed_base
-    _check_seeds_free(range(seed_base, seed_base + episodes), read_meta(model_dir).get("further_evaluations", []),
+    _check_seeds_free(range(seed_base, seed_base + episodes), recorded.get("further_evaluations", []),
                       "a further evaluation")
     exp, meta, policy = load_policy(model_dir, experiment, algo)
     meta["evaluation"], line = run_evaluation(exp, policy, episodes, seed_base, meta)
@@ -159,6 +163,18 @@ def evaluate_into_meta(model_dir: Path, episodes: int, seed_base: int | None = N
     write_json(model_dir / "meta.json", meta)
     print(f"evaluation (unseen seeds): {line}")
     return meta
+
+
+def _replace_refusal(model_dir: Path, evaluation: dict, exp, meta: dict) -> str:
+    """The line refusing to overwrite a recorded evaluation, naming it and the two ways on."""
+    from rlcore.allowed import in_python
+
+    words = score_words(evaluation, exp.name, model_name(exp, meta), plus_minus="+-")
+    seeds = f" on seeds {evaluation['seeds']}" if evaluation.get("seeds") else ""
+    further, replace = (("record_further=True", "replace=True") if in_python() else
+                        ("--record-further", "--replace"))
+    return (f"{model_dir / 'meta.json'} records an evaluation already ({words}, {evaluation.get('episodes')} "
+            f"episodes{seeds}); {further} adds one on other unseen seeds, {replace} overwrites it")
 
 
 def seed_range(evaluation: dict) -> range:

@@ -92,6 +92,10 @@ def test_train_records_the_call_evaluates_and_renders(tmp_path):
     meta = json.loads((run.model_dir / "meta.json").read_text())
     assert further["seeds"] == "1000003..1000004" and meta["further_evaluations"] == [further]
     assert meta["evaluation"] == run.evaluation
+    with pytest.raises(UserError, match=r"meta.json records an evaluation already \(.*, 3 episodes on seeds "
+                                        r"1000000..1000002\); record_further=True adds one .* replace=True overwrites it$"):
+        api.evaluate(run, episodes=1, record=True)
+    assert json.loads((run.model_dir / "meta.json").read_text()) == meta
     assert [table for table, _ in rows] == ["metrics"] * 4 and rows[-1][1]["episode"] == 4
     video = api.render(run, tmp_path / "clip.mp4", episodes=1)
     import imageio.v2 as imageio
@@ -103,6 +107,22 @@ def test_train_records_the_call_evaluates_and_renders(tmp_path):
         api.train("cartpole", "dqn", run_dir=tmp_path / "other", episodes=1, max_episodes=2)
     with pytest.raises(UserError, match=r"^out='.*clip\.avi': give a file name ending in \.mp4 or \.gif"):
         api.render(run, tmp_path / "clip.avi")
+
+
+@pytest.mark.parametrize("call, kwargs, message", [
+    ("evaluate", {"episodes": 2.5}, "^episodes=2.5 is invalid: allowed is a whole number from 1 to 1000000$"),
+    ("evaluate", {"episodes": "3"}, "^episodes='3' is invalid"), ("evaluate", {"episodes": 0}, "^episodes=0 is invalid"),
+    ("evaluate", {"seed_base": -1}, "^seed_base=-1 is invalid: allowed is a whole number of at least 0$"),
+    ("render", {"fps": 0}, "^fps=0 is invalid: allowed is a whole number from 1 to 240$"),
+    ("render", {"seed": -2}, "^seed=-2 is invalid"), ("render", {"episodes": 1.0}, "^episodes=1.0 is invalid"),
+])
+def test_evaluate_and_render_check_their_arguments_as_the_command_line_does(tmp_path, call, kwargs, message):
+    with pytest.raises(UserError, match=message):
+        if call == "render":
+            api.render(("cartpole", "dqn"), tmp_path / "clip.mp4", **kwargs)
+        else:
+            api.evaluate(("cartpole", "dqn"), **kwargs)
+    assert not list(tmp_path.iterdir())
 
 
 def test_resume_goes_on_from_the_checkpoint_records_the_call_and_what_it_changed(tmp_path):
@@ -123,6 +143,20 @@ def test_resume_goes_on_from_the_checkpoint_records_the_call_and_what_it_changed
         api.resume(tmp_path / "run", episodes=6, hidden=(8, 8))  # a network of another size is another run
     with pytest.raises(UserError, match="holds no checkpoint.npz to resume from"):
         api.resume(tmp_path / "nothing")
+
+
+def test_a_resume_keeps_the_runs_final_evaluation_and_wandb_mode_unless_given(tmp_path):
+    """A run started with final_eval_episodes=2 and wandb off is evaluated on 2 episodes after a resume that
+    does not say (not the experiment's 100) and makes no wandb folder; given again, they change."""
+    from rlcore.checkpoint import read_checkpoint_state
+
+    first = api.train("cartpole", "dqn", run_dir=tmp_path / "run", episodes=2, final_eval_episodes=2, progress=False)
+    state = read_checkpoint_state(first.run_dir / "checkpoint.npz")
+    assert (state["wandb_mode"], state["final_eval_episodes"]) == ("off", 2)
+    run = api.resume(first, episodes=3, progress=False)
+    assert run.meta["evaluation"]["episodes"] == 2 and not (first.run_dir / "wandb").exists()
+    run = api.resume(first, episodes=4, final_eval_episodes=1, progress=False)
+    assert run.meta["evaluation"]["episodes"] == 1
 
 
 def test_a_run_in_progress_loads_from_its_checkpoint(tmp_path):

@@ -252,10 +252,12 @@ def test_ctrl_c_saves_a_checkpoint_and_resume_continues(tmp_path, signal_name, c
     assert "checkpoint saved to" in err and "Traceback" not in err
     episodes_before = len((run_dir / "metrics.csv").read_text().splitlines()) - 1
     capsys.readouterr()
-    # the resume in this process: nothing signals it
-    assert main.main(cmd[2:-4] + ["--resume", str(run_dir), "--episodes", str(episodes_before + 3),
-                                  "--final-eval-episodes", "0"]) == 0
+    # the resume in this process: nothing signals it; --wandb off and --final-eval-episodes 0 are the run's
+    assert main.main(["train", "lunar_lander", "dqn", "--no-progress", "--resume", str(run_dir),
+                      "--episodes", str(episodes_before + 3)]) == 0
     out = capsys.readouterr().out
+    assert "evaluation (unseen seeds)" not in out and not (run_dir / "wandb").exists()
+    assert "evaluation" not in json.loads((run_dir / "model" / "meta.json").read_text())
     assert f"resuming {run_dir} at episode {episodes_before}" in out
     assert "; changing max_episodes " in out and f" -> {episodes_before + 3:,}\n" in out  # what the resume changes
     rows = (run_dir / "metrics.csv").read_text().splitlines()[1:]
@@ -352,8 +354,13 @@ def test_a_further_evaluation_plays_the_next_unseen_seeds_and_keeps_the_evaluati
             (["--record-further", "--seed-base", "5"], "plays seeds 5..7, outside toy's unseen range 10000..1999999"),
             (["--record-further", "--record"], "give --record (the model's evaluation) or --record-further"),
             # a new evaluation over the further ones' seeds would leave them no longer held out
-            (["--record", "--episodes", "20"], "seeds 10000..10019 overlap those of a further evaluation already "
-                                               "recorded (10005..10007)")):
+            (["--record", "--replace", "--episodes", "20"], "seeds 10000..10019 overlap those of a further "
+                                                            "evaluation already recorded (10005..10007)"),
+            # the recorded evaluation is not overwritten by a smaller try unless asked
+            (["--record"], "meta.json records an evaluation already (" + f"{evaluation['mean']:.2f} +- "
+                           f"{evaluation['std']:.2f}, 5 episodes on seeds 10000..10004); --record-further adds one "
+                           "on other unseen seeds, --replace overwrites it"),
+            (["--replace"], "--replace goes with --record")):
         code, _, err = run(capsys, *model, "--episodes", "3", *argv)
         assert code == 2 and message in err and len(err.strip().splitlines()) == 1, err
     assert json.loads(meta_path.read_text()) == meta  # nothing written by a refused command

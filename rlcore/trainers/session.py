@@ -139,6 +139,8 @@ class TrainingSession:
                                     if len(self.book.counted_returns) != self.book.episodes else None),
                 "solved_episode": self.book.solved_episode, "env_steps": self.env_steps,
                 "wall_seconds": self.elapsed(), "wandb_id": self.tracker.wandb_id,
+                # what a resume keeps unless given again (recorded from 2026-11-28 on)
+                "wandb_mode": self.spec.wandb_mode, "final_eval_episodes": self.spec.final_eval_episodes,
                 **self.evaluation.state(), "commands": self.commands, "command_starts": self.command_starts,
                 **extra}
 

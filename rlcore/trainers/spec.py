@@ -26,7 +26,7 @@ class RunSpec:
     preset: str
     config: object
     seed: int
-    wandb_mode: str = "auto"
+    wandb_mode: str = "auto"  # as asked: auto, online, offline or off (a resume keeps the run's)
     run_dir: Path | None = None
     resume: bool = False
     command: str = field(default_factory=lambda: " ".join(shlex.quote(a) for a in ["python", *sys.argv]))
@@ -38,6 +38,8 @@ class RunSpec:
     # a resume's hyperparameters that differ from its checkpoint's, name -> [before, after] (JSON values):
     # meta.json keeps them beside the command, so a run's settings can be followed from start to end
     changes: dict = field(default_factory=dict)
+    # episodes of the final evaluation on unseen seeds (None: the experiment's default; a resume keeps the run's)
+    final_eval_episodes: int | None = None
 
     @property
     def kind(self) -> str:
@@ -68,7 +70,8 @@ def latest_run_dir(experiment: str, algo: str) -> Path:
     runs = sorted(RUNS_DIR.glob(f"{glob.escape(folder_safe(experiment))}__{algo}__*/{CHECKPOINT_FILE}"),
                   key=lambda p: p.stat().st_mtime)
     if not runs:
-        raise UserError(f"no run of {experiment} {algo} with a checkpoint under {RUNS_DIR}/ to resume")
+        raise UserError(f"no run of {experiment} {algo} with a checkpoint under {RUNS_DIR}/ to resume; a run "
+                        f"started with --run-dir DIR resumes with --resume DIR")
     return runs[-1].parent
 
 
