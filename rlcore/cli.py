@@ -244,6 +244,8 @@ def _run_folder(run_dir: Path) -> dict:
     or without metrics.csv, is a clear error."""
     from rlcore.status import run_record
 
+    if not run_dir.is_dir():
+        raise UserError(f"{run_dir}: no such folder; give a run folder such as runs/<name>")
     if not (run_dir / "metrics.csv").is_file():
         raise UserError(f"no metrics.csv in {run_dir}; give a run folder such as runs/<name>")
     record = run_record(run_dir)

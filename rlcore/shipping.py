@@ -115,7 +115,7 @@ def run_evaluation(exp, policy, episodes: int, seed_base: int | None, meta: dict
         if goal.cause_key and (causes := count_causes(records, goal.cause_key, goal.cause_name)):
             summary["causes"] = dict(causes)
             line += f"; {goal.cause_key}: " + ", ".join(f"{name} {count}" for name, count in causes)
-        return summary, line + f" (seeds {seeds}, actions sampled from pi)"
+        return summary, line + _bar_words(exp, meta, summary) + f" (seeds {seeds}, actions sampled from pi)"
     from rlcore.evaluation import play_greedy
 
     records = play_greedy(exp, policy, episodes, seed_base, make_env=policy.make_env,
@@ -136,8 +136,17 @@ def run_evaluation(exp, policy, episodes: int, seed_base: int | None, meta: dict
             summary[f"mean_{key}"] = round(float(np.mean(values)), 2)
             line += f"; {key} at the end: mean {np.mean(values):.2f}, max {np.max(values):.2f}"
     if exp.solved_score is not None:
-        line += f"; solved threshold {exp.solved_score:g}: {'met' if returns.mean() >= exp.solved_score else 'not met'}"
-    return summary, line
+        line += f"; the task's solved score {exp.solved_score:g}: {'met' if returns.mean() >= exp.solved_score else 'not met'}"
+    return summary, line + _bar_words(exp, meta, summary)
+
+
+def _bar_words(exp, meta: dict | None, summary: dict) -> str:
+    """``; the shipped model's bar (mean return >= 230): met``, for a model of an algorithm or level that
+    ships one with a bar (the task's solved score is another number: LunarLander's 200, Minitaur's 15)."""
+    bar = exp.bar(model_name(exp, meta) or str(meta.get("algo", ""))) if meta else None
+    if bar is None:
+        return ""
+    return f"; the shipped model's bar ({bar.describe()}): {'met' if bar.met_by(summary) else 'not met'}"
 
 
 def evaluate_into_meta(model_dir: Path, episodes: int, seed_base: int | None = None,

@@ -61,7 +61,8 @@ def dqn_model_dir(tmp_path):
     (["evaluate", "cartpole", "a2c", "--model", "docs"], "docs has no meta.json: not a model folder of this package"),
     (["render", "lunar_lander", "sac"], "unknown algorithm 'sac'"),
     (["evaluate", "mario_ppo", "ppo", "--model", "/nonexistent/1-1"], "no such model folder"),
-    (["plot", "/nonexistent/run"], "no metrics.csv in /nonexistent/run"),
+    (["plot", "/nonexistent/run"], "/nonexistent/run: no such folder; give a run folder such as runs/<name>"),
+    (["status", "docs"], "no metrics.csv in docs; give a run folder"),
     (["evaluate", "mario_ppo", "ppo", "--world", "8", "--stage", "4"], "no shipped model for level 8-4 in "),
     (["evaluate", "CartPole-v1", "dqn"], "no shipped model CartPole-v1 dqn in "),
     (["render", "lunar_lander", "dqn", "--world", "1"], "--world chooses among the shipped models of mario_ppo; "
@@ -290,6 +291,10 @@ def test_shipped_models_are_found_from_any_working_directory(capsys, tmp_path, m
     monkeypatch.chdir(tmp_path)
     code, out, _ = run(capsys, "evaluate", "lunar_lander", "dqn", "--episodes", "2")
     assert code == 0 and "greedy return" in out
+    from rlcore.experiment import get_experiment
+    lander = get_experiment("lunar_lander")  # the task's number and ours, each named
+    assert f"; the task's solved score {lander.solved_score:g}: " in out
+    assert f"; the shipped model's bar ({lander.bar('dqn').describe()}): " in out
     code, out, _ = run(capsys, "list")
     assert code == 0 and "1-1: flag in" in out and "shipped: " in out
 
