@@ -3,11 +3,11 @@ page, all written from each model folder's meta.json and the kept sweeps. Part o
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
-from rlcore.docgen import (GENERATED_NOTE, REPO, Model, bar_met, bar_text, eval_text, link, OVER_SEEDS_HEADER,
-                           model_page, num, over_seeds_bold, over_seeds_cell, policy_text, ret, region_bars, region_shipped, region_sweeps,
-                           score_text, sweep_score, table, EXPERIMENT_PAGES, article_of)
+from rlcore.docgen import EXPERIMENT_PAGES, region_bars, region_shipped, region_sweeps
+from rlcore.docgen_data import GENERATED_NOTE, REPO, Model
+from rlcore.docgen_words import (OVER_SEEDS_HEADER, article_of, bar_met, bar_text, eval_text, link, model_page, num,
+                                 over_seeds_bold, over_seeds_cell, policy_text, ret, score_text, sweep_score, table)
 from rlcore.docgen_sweeps import stop_text
 from rlcore.experiment import experiment_names, get_experiment
 from rlcore.hparams import to_dict

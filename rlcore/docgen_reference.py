@@ -6,7 +6,8 @@ import argparse
 import dataclasses
 
 from rlcore.allowed import field_values
-from rlcore.docgen import GENERATED_NOTE, table
+from rlcore.docgen_data import GENERATED_NOTE
+from rlcore.docgen_words import table
 from rlcore.experiment import experiment_names, get_experiment
 
 HELP_WIDTH = 100  # fixed, so the page does not depend on the terminal that generated it

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from rlcore import docgen_data  # its REPO and shipped_models read at each call (tests point them elsewhere)
 from rlcore.critic_trace import WINDOW, critic_cell, critic_trace
+from rlcore.docgen_words import link, num, over_seeds_bold, score_text, sweep_score, table
 from rlcore.eval_history import stability_summary, steps_text, story
 from rlcore.experiment import get_experiment
 
@@ -55,7 +56,6 @@ def collapses_cell(collapses: list) -> str:
 
 
 def sweep_stability(page: str, experiment: str) -> str:
-    from rlcore.docgen import link, sweep_score, table
 
     parts = []
     for m, runs in _kept_sweeps(experiment):
@@ -94,7 +94,6 @@ def sweep_stability(page: str, experiment: str) -> str:
 
 
 def seed_summary(page: str, experiment: str) -> str:
-    from rlcore.docgen import link, over_seeds_bold, score_text
 
     parts = []
     for m, runs in _kept_sweeps(experiment):
@@ -132,7 +131,6 @@ def evaluation_cell(evaluation: dict, m) -> str:
     """``flag in 9 of 10`` (Mario), ``257.4 over 100``, and where the bar asks for episodes that last to the
     time limit, ``18.56 over 30 (93% full length)``: one recorded evaluation, with the digits of the
     shipped score (:mod:`rlcore.score_words`)."""
-    from rlcore.docgen import sweep_score
     from rlcore.score_words import score_words
 
     if "success_share" in evaluation:
@@ -147,7 +145,6 @@ def evaluation_cell(evaluation: dict, m) -> str:
 def stop_text(meta: dict, m) -> str:
     """What ended a run, in words (meta.json's ``stopped_by`` names the rule and its value: ``max_env_steps
     1000000`` -> ``its budget of 1,000,000 env steps``); a rule not known here, as recorded."""
-    from rlcore.docgen import num
     from rlcore.score_words import success_word
 
     recorded = meta.get("stopped_by") or ""
@@ -167,7 +164,6 @@ def stop_text(meta: dict, m) -> str:
 
 
 def seed_runs(page: str, experiment: str) -> str:
-    from rlcore.docgen import link, over_seeds_bold, score_text, table
 
     parts = []
     for m, runs in _kept_sweeps(experiment):

@@ -183,7 +183,7 @@ def test_list_and_help(capsys):
 
 def test_list_writes_each_shipped_score_as_the_readme_does(capsys):
     """`list` and the README's results table read the same meta.json: the same words and digits."""
-    from rlcore.docgen import score_text
+    from rlcore.docgen_words import score_text
     from rlcore.docgen_data import shipped_models
 
     code, out, _ = run(capsys, "list")
