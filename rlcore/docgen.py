@@ -22,7 +22,7 @@ import sys
 
 from rlcore.docgen_data import REPO, Model, shipped_models
 from rlcore.experiment import get_experiment, experiment_names
-from rlcore.docgen_words import (OVER_SEEDS_HEADER, article_of, bar_met, bar_text, link, model_page,
+from rlcore.docgen_words import (OVER_SEEDS_HEADER, article_of, bar_met, bar_text, hours, link, model_page,
                                  over_seeds_cell, ret, score_text, sweep_score, table)
 
 #: the docs page of each experiment (cartpole_v0 shares CartPole's page)
@@ -80,7 +80,7 @@ def region_shipped(page: str, experiment: str) -> str:
             continue
         meta, best = m.meta, m.meta.get("best_eval") or {}
         rows.append([f"[{m.name}]({link(page, card_path(m, page))})", f"`{meta.get('preset')}`",
-                     f"{meta['env_steps']:,}", f"{meta['episodes']:,}", f"{meta['wall_seconds']:,.0f} s",
+                     f"{meta['env_steps']:,}", f"{meta['episodes']:,}", hours(meta["wall_seconds"]),
                      ret(best["mean"]) if "mean" in best else "–",
                      f"**{score_text(m)}** ({m.evaluation.get('episodes', '?')} ep.)",
                      f"{bar_text(m)}: {bar_met(m)}" if m.bar else "none set"])

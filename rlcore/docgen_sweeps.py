@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from rlcore import docgen_data  # its REPO and shipped_models read at each call (tests point them elsewhere)
 from rlcore.critic_trace import WINDOW, critic_cell, critic_trace
-from rlcore.docgen_words import link, num, over_seeds_bold, score_text, sweep_score, table
+from rlcore.docgen_words import hours, link, num, over_seeds_bold, score_text, sweep_score, table
 from rlcore.eval_history import stability_summary, steps_text, story
 from rlcore.experiment import get_experiment
 
@@ -98,7 +98,7 @@ def seed_summary(page: str, experiment: str) -> str:
     parts = []
     for m, runs in _kept_sweeps(experiment):
         per_seed = "; ".join(f"{meta['seed']}: {evaluation_cell(meta['evaluation'], m)} after "
-                             f"{meta['env_steps']:,} env steps, {_hours(meta['wall_seconds'])}" for meta, _ in runs)
+                             f"{meta['env_steps']:,} env steps, {hours(meta['wall_seconds'])}" for meta, _ in runs)
         parts.append(f"{m.title}, the same recipe over {len(m.sweep.seeds)} seeds "
                      f"([report]({link(page, m.sweep.folder + '/report.md')})): {over_seeds_bold(m, '[95% CI] ')}; "
                      f"per seed {per_seed}; the shipped model (seed {m.meta.get('seed')}, a run of its own) "
@@ -121,10 +121,6 @@ def seeds_bar_text(m) -> str:
     verdict = ({True: "**met**", False: "**not met**"}[met] if met is not None
                else f"not judged yet ({len(scores)} of {bar.seeds} seeds kept)")
     return f" Bar over seeds: {bar.describe('success_share' in m.evaluation)} ({bar.reason}): {verdict}."
-
-
-def _hours(seconds: float) -> str:
-    return f"{seconds / 3600:.1f} h" if seconds >= 3600 else f"{seconds:,.0f} s"
 
 
 def evaluation_cell(evaluation: dict, m) -> str:
@@ -173,7 +169,7 @@ def seed_runs(page: str, experiment: str) -> str:
             further = "; ".join(f"{evaluation_cell(f, m)} ({f.get('seeds')})"
                                 for f in meta.get("further_evaluations", [])) or "–"
             rows.append([str(meta["seed"]), evaluation_cell(ev, m), further, f"{meta['env_steps']:,}",
-                         _hours(meta["wall_seconds"]), f"{meta['env_steps'] / max(meta['wall_seconds'], 1e-9):,.0f}",
+                         hours(meta["wall_seconds"]), f"{meta['env_steps'] / max(meta['wall_seconds'], 1e-9):,.0f}",
                          stop_text(meta, m)])
         parts.append(f"**[{m.name}]({link(page, m.sweep.folder + '/report.md')})**, beside the shipped model's "
                      f"{score_text(m)}:\n\n"

@@ -15,6 +15,11 @@ def num(value: float, digits: int = 1) -> str:
     return f"{value:,.{digits}f}"
 
 
+def hours(seconds: float) -> str:
+    """A wall time as the tables write it: ``3.1 h`` from an hour up, else ``725 s``."""
+    return f"{seconds / 3600:.1f} h" if seconds >= 3600 else f"{seconds:,.0f} s"
+
+
 def ret(value: float, near: float | None = None) -> str:
     """A return with the README's digits for a score near ``near`` (itself when not given): 257.4, 18.56."""
     return num(value, return_digits(value if near is None else near))
