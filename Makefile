@@ -69,6 +69,9 @@ benchmark: $(ALL)
 # The docs: regenerate every generated page, card and README region from the artefacts, then build the
 # site into build/site/. docs-check changes nothing: it fails on drift or on a broken link (make test
 # runs the same checks in tests/test_docs.py).
+# mkdocs-material prints a banner about MkDocs 2 on every build; the site builds with MkDocs 1 (the lock)
+docs docs-check: export NO_MKDOCS_2_WARNING = 1
+
 docs: $(ALL)
 	$(PY) -m rlcore.docgen
 	$(VENV)/bin/mkdocs build --strict --quiet

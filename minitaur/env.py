@@ -22,6 +22,9 @@ camera (distance 1 m, yaw 0, pitch -30).
 """
 from __future__ import annotations
 
+import os
+import weakref
+
 import gymnasium as gym
 import numpy as np
 
@@ -63,6 +66,9 @@ class MinitaurEnv(gym.Env):
             from pybullet_utils import bullet_client
 
             self.p = bullet_client.BulletClient(connection_mode=pybullet.DIRECT)
+        # disconnect while pybullet is still importable: an env never closed by hand is otherwise left to
+        # BulletClient.__del__ at interpreter exit, which prints a TypeError traceback (pybullet gone)
+        self._disconnect = weakref.finalize(self, _disconnect, self.p)
         self.render_mode, self.randomize, self.render_size = render_mode, randomize, render_size
         self._pybullet = pybullet
         self._urdf_root = pybullet_data.getDataPath()
@@ -135,11 +141,20 @@ class MinitaurEnv(gym.Env):
 
     def close(self):
         if getattr(self, "p", None) is not None:
-            try:
-                self.p.disconnect()
-            except Exception:  # already disconnected
-                pass
+            self._disconnect()
             self.p = None
+
+
+def _disconnect(client) -> None:
+    """Disconnect ``client`` once, in the process that connected it (as its ``__del__`` checks); its
+    ``__del__`` then has nothing left to do."""
+    if client._client < 0 or client._pid != os.getpid():
+        return
+    try:
+        client.disconnect()
+    except Exception:  # already disconnected
+        pass
+    client._client = -1
 
 
 def register() -> None:

@@ -165,6 +165,15 @@ def field_values(f: dataclasses.Field) -> str:
     return allowed.describe()
 
 
+def field_words(f: dataclasses.Field) -> str:
+    """:func:`field_values` of a whole field: a list field (hidden sizes) says it takes a list of them."""
+    values = field_values(f)
+    if values and str(f.type).startswith("tuple"):
+        empty = " (or empty)" if f.metadata["allowed"].empty_ok else ""
+        return f"a comma-separated list, each item {values}{empty}"
+    return values
+
+
 def _whole_words(allowed: Allowed) -> str:
     return allowed.describe().replace("a number", "a whole number", 1)
 
@@ -178,14 +187,12 @@ def check_fields(cfg) -> None:
         if allowed is None:
             continue
         whole = str(f.type) in ("int", "tuple[int, ...]")
-        describe = field_values(f)
         fits = (lambda item: allowed.accepts(item) and (_is_whole(item) or not whole))
         if isinstance(value, tuple) or str(f.type).startswith("tuple"):  # a list field (hidden=64 is not one)
             if not isinstance(value, tuple) or (not value and not allowed.empty_ok) or not all(map(fits, value)):
-                empty = " (or empty)" if allowed.empty_ok else ""
-                raise invalid(f.name, value, f"a comma-separated list, each item {describe}{empty}")
+                raise invalid(f.name, value, field_words(f))
         elif not fits(value):
-            raise invalid(f.name, value, describe)
+            raise invalid(f.name, value, field_values(f))
 
 
 def whole_number(allowed: Allowed):

@@ -172,7 +172,7 @@ def load(model: ModelRef | Policy) -> Policy:
 def evaluate(model: ModelRef | Policy, episodes: int | None = None, seed_base: int | None = None,
              record: bool = False, record_further: bool = False, replace: bool = False) -> dict[str, Any]:
     """Evaluate on unseen seeds as ``main.py evaluate`` does (episode i seeded ``seed_base + i``,
-    default the experiment's evaluation range; ``episodes`` default 100, Mario 10): greedy
+    default the experiment's evaluation range; ``episodes`` default the experiment's ``eval_episodes``): greedy
     mean/std/min of the return and per-episode records, or for Mario the share of episodes that
     reached the flag. ``line`` holds the one-line report. ``record``: also write it into the model
     folder's meta.json as its evaluation (one recorded already is replaced only with ``replace``).

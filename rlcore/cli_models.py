@@ -115,7 +115,8 @@ def render_video(model_dir: Path, out: Path, fps: int | None, episodes: int | No
     shown = (f"{result['frames']} frames at {result['fps']} fps" if "every" not in result else
              f"{result['frames']} frames from {result['frames_played']} at {result['fps']} fps: 1 in "
              f"{result['every']} kept, repeats merged; {result['bytes'] / 1e6:.2f} MB")
-    reached = f"; reached the goal: {result['success']}" if "success" in result else ""
+    reached = (f"; reached the goal in {sum(map(bool, result['success']))} of {len(result['success'])}"
+               if "success" in result else "")
     print(f"video:   {out} ({shown}; "
           f"episode returns {', '.join(f'{r:.1f}' for r in result['returns'])}{reached})")
 

@@ -108,8 +108,9 @@ def _algorithms_by_experiment() -> str:
 
 
 def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentParser:
-    from rlcore.experiment import experiment_names
+    from rlcore.experiment import eval_episodes_words, experiment_names
 
+    episodes = eval_episodes_words()
     prog = prog or program_name()
     parser = _Parser(
         prog=prog, description="TensorFlow 2 / Keras deep RL: train, evaluate, render and export agents.",
@@ -117,7 +118,9 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
     parser.add_argument("--version", action="version", version=f"%(prog)s {package_version()}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND", parser_class=_Parser)
 
-    sub.add_parser("list", help="experiments, algorithms, presets and shipped models with their scores")
+    text = "experiments, algorithms, presets and shipped models with their scores"
+    sub.add_parser("list", help=text, description=text[0].upper() + text[1:] + ", as the shipped models' "
+                   "meta.json record them.")
 
     train = sub.add_parser("train", help="train an agent (Ctrl-C or SIGTERM saves a checkpoint; --resume continues)",
                            description="Train an agent. Every hyperparameter of the chosen preset can be "
@@ -143,7 +146,7 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
     train.add_argument("--run-dir", default=None, help="where the run writes (default runs/<name>)")
     train.add_argument("--final-eval-episodes", type=FINAL_EVAL_EPISODES, default=None,
                        help="evaluation episodes after training, on unseen seeds "
-                            "(default 100; Mario 10; 0 = none; a resume: the run's)")
+                            f"({episodes}; 0 = none; a resume: the run's)")
     train.add_argument("--video", action="store_true", help="also render an MP4 of the trained agent")
     train.add_argument("--publish", action="store_true",
                        help="copy the trained model into saved_networks/EXPERIMENT/ALGO/, replacing the "
@@ -157,7 +160,7 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
         p = sub.add_parser(name, help=text, description=text)
         _add_model_choice(p, experiment_names())
         if name == "evaluate":
-            p.add_argument("--episodes", type=EVAL_EPISODES, default=None, help="default 100; Mario 10")
+            p.add_argument("--episodes", type=EVAL_EPISODES, default=None, help=episodes)
             p.add_argument("--seed-base", type=NON_NEGATIVE, default=None,
                            help="episode i uses seed SEED_BASE+i (default: the experiment's unseen range)")
             p.add_argument("--record", action="store_true",
@@ -210,7 +213,7 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
     sweep.add_argument("--steps", type=COUNT, default=None, help="env step budget of each run (as train's --steps: it ends at the end of the "
                        "episode or rollout that reaches it)")
     sweep.add_argument("--final-eval-episodes", type=FINAL_EVAL_EPISODES, default=None,
-                       help="evaluation episodes on unseen seeds after each run (default 100; Mario 10)")
+                       help=f"evaluation episodes on unseen seeds after each run ({episodes})")
     sweep.add_argument("--max-concurrent", type=NON_NEGATIVE, default=0,
                        help="trials at once (default 0: as many as the CPUs allow)")
     sweep.add_argument("--cpus-per-run", type=whole_number(Allowed(low=1, high=256)), default=1,

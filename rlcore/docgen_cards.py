@@ -101,17 +101,25 @@ def usage_section(m: Model) -> str:
         cmd.format("evaluate") + "   # score it again on the unseen seeds",
         cmd.format("render") + f" --out {m.slug}.mp4",
         "```", "",
-        "From Python, with the loader the CLI uses (it rebuilds the env and network from meta.json):", "",
+        "From Python (`rlcore.api`): the model is rebuilt from its folder's meta.json, env included, "
+        "from any working folder:", "",
         "```python",
-        "from rlcore.policies import load_policy",
+        "from rlcore import api",
         "",
-        f'experiment, meta, policy = load_policy("{m.folder}")',
+        f'policy = api.load(("{m.experiment}", "{m.name}"))',
         "env = policy.make_env()",
         f"obs, info = env.reset(seed={exp.eval_seed_base})",
-        "action = policy(obs[None])[0]" + ("   # the mean action" if m.meta.get("kind") == "sac" else
-                                           "   # greedy; policy.sample(obs[None], rng) draws from pi"
-                                           if m.meta.get("kind") in ("a2c", "ppo") else "   # greedy"),
+        "action = policy.predict(obs)" + _action_comment(m.meta.get("kind")),
+        f"print(api.evaluate(policy, episodes={min(exp.eval_episodes, 10)})[\"line\"])   # as `main.py evaluate` prints it",
         "```", ""])
+
+
+def _action_comment(kind: str | None) -> str:
+    if kind == "sac":
+        return "   # the mean action, in [-1, 1]: the env rescales it"
+    if kind in ("a2c", "ppo"):
+        return "   # greedy; predict(obs, deterministic=False, rng=rng) draws from pi"
+    return "   # greedy"
 
 
 def _when(entry) -> str:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 
-from rlcore.allowed import field_values
+from rlcore.allowed import field_words
 from rlcore.docgen_data import GENERATED_NOTE
 from rlcore.docgen_words import table
 from rlcore.experiment import experiment_names, get_experiment
@@ -13,12 +13,10 @@ from rlcore.experiment import experiment_names, get_experiment
 HELP_WIDTH = 100  # fixed, so the page does not depend on the terminal that generated it
 
 
-def _formatter(prog: str) -> argparse.HelpFormatter:
-    return argparse.HelpFormatter(prog, width=HELP_WIDTH)
-
-
 def _help(parser: argparse.ArgumentParser) -> str:
-    parser.formatter_class = _formatter
+    """``--help`` at a fixed width, in the parser's own formatter (the top one keeps its examples' lines)."""
+    kind = parser.formatter_class
+    parser.formatter_class = lambda prog: kind(prog, width=HELP_WIDTH)
     return parser.format_help().rstrip()
 
 
@@ -76,7 +74,7 @@ def hyperparameters_page() -> str:
                 # a value that differs from the default preset's is shown in bold
                 shown = [f"**{v}**" if v != values[list(presets).index(spec.default_preset)] else v for v in values]
                 rows.append([f"`--{f.name.replace('_', '-')}`", *shown,
-                             field_values(f) or ("true or false" if f.type in (bool, "bool") else ""),
+                             field_words(f) or ("true or false" if f.type in (bool, "bool") else ""),
                              f.metadata.get("help", "").replace("%%", "%").replace("|", "\\|")])
             parts += [table(["flag", *[f"`{p}`" for p in presets], "allowed", "what it does"], rows), ""]
     return "\n".join(parts)

@@ -248,6 +248,14 @@ def experiment_names() -> list[str]:
     return list(EXPERIMENT_MODULES)
 
 
+def eval_episodes_words() -> str:
+    """How many episodes each experiment's evaluation on unseen seeds runs, for ``--help``: "default
+    100; mario_ppo 10; minitaur 30", read from the experiments (their modules import no TensorFlow)."""
+    counts = {name: get_experiment(name).eval_episodes for name in EXPERIMENT_MODULES}
+    default = Experiment.eval_episodes
+    return "; ".join([f"default {default}"] + [f"{name} {n}" for name, n in counts.items() if n != default])
+
+
 def get_experiment(name: str, env_record: dict | None = None) -> Experiment:
     """The experiment ``name``: a package's (``lunar_lander`` ...), else a registered Gymnasium id
     (``Acrobot-v1``, or ``my_envs:Maze-v0`` to import ``my_envs`` first; :mod:`rlcore.gym_experiment`).

@@ -10,7 +10,7 @@ import dataclasses
 import os
 import typing
 
-from rlcore.allowed import field_values, flag, setting
+from rlcore.allowed import field_words, flag, setting
 from rlcore.errors import UserError
 
 
@@ -64,7 +64,7 @@ def add_arguments(parser: argparse.ArgumentParser, cfg) -> None:
 
 
 def _allowed_text(f: dataclasses.Field) -> str:
-    return f"; allowed: {values}" if (values := field_values(f)) else ""
+    return f"; allowed: {values}" if (values := field_words(f)) else ""
 
 
 def overrides_from_args(args: argparse.Namespace) -> dict:

@@ -115,7 +115,7 @@ def run_evaluation(exp, policy, episodes: int, seed_base: int | None, meta: dict
         if goal.cause_key and (causes := count_causes(records, goal.cause_key, goal.cause_name)):
             summary["causes"] = dict(causes)
             line += f"; {goal.cause_key}: " + ", ".join(f"{name} {count}" for name, count in causes)
-        return summary, line + _bar_words(exp, meta, summary) + f" (seeds {seeds}, actions sampled from pi)"
+        return summary, line + _bar_words(exp, meta, summary, seed_base) + f" (seeds {seeds}, actions sampled from pi)"
     from rlcore.evaluation import play_greedy
 
     records = play_greedy(exp, policy, episodes, seed_base, make_env=policy.make_env,
@@ -137,16 +137,24 @@ def run_evaluation(exp, policy, episodes: int, seed_base: int | None, meta: dict
             line += f"; {key} at the end: mean {np.mean(values):.2f}, max {np.max(values):.2f}"
     if exp.solved_score is not None:
         line += f"; the task's solved score {exp.solved_score:g}: {'met' if returns.mean() >= exp.solved_score else 'not met'}"
-    return summary, line + _bar_words(exp, meta, summary)
+    return summary, line + _bar_words(exp, meta, summary, seed_base)
 
 
-def _bar_words(exp, meta: dict | None, summary: dict) -> str:
+def _bar_words(exp, meta: dict | None, summary: dict, seed_base: int) -> str:
     """``; the shipped model's bar (mean return >= 230): met``, for a model of an algorithm or level that
-    ships one with a bar (the task's solved score is another number: LunarLander's 200, Minitaur's 15)."""
+    ships one with a bar (the task's solved score is another number: LunarLander's 200, Minitaur's 15).
+    The bar is judged on the experiment's evaluation (its episode count, on its unseen seeds): fewer
+    episodes, or seeds outside that range, say so beside the verdict."""
     bar = exp.bar(model_name(exp, meta) or str(meta.get("algo", ""))) if meta else None
     if bar is None:
         return ""
-    return f"; the shipped model's bar ({bar.describe()}): {'met' if bar.met_by(summary) else 'not met'}"
+    caveats = []
+    if summary["episodes"] < exp.eval_episodes:
+        caveats.append(f"on {summary['episodes']} episodes, where it is judged on {exp.eval_episodes}")
+    if not exp.eval_seed_base <= seed_base < exp.selection_seed_base:
+        caveats.append("on seeds outside the unseen range, which training may have met")
+    verdict = "met" if bar.met_by(summary) else "not met"
+    return f"; the shipped model's bar ({bar.describe()}): {verdict}" + (f" ({'; '.join(caveats)})" if caveats else "")
 
 
 def evaluate_into_meta(model_dir: Path, episodes: int, seed_base: int | None = None,

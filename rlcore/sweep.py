@@ -29,6 +29,7 @@ import os
 import signal
 import sys
 import time
+import dataclasses
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
@@ -131,9 +132,21 @@ def parse_grid(items: list[str], config) -> dict[str, list]:
             # tuple fields (hidden sizes) take ';' between values: --grid hidden=64,64;128,128
             sep_values = values.split(";") if isinstance(getattr(config, name), tuple) else values.split(",")
             grid[name] = [types[name](v.strip()) for v in sep_values if v.strip()]
-        except (ValueError, argparse.ArgumentTypeError) as exc:  # the latter: a bad true/false
+        except argparse.ArgumentTypeError as exc:  # a bad true/false says what it allows
             raise UserError(f"--grid {item!r} is invalid: {exc}") from None
+        except ValueError:  # float('abc') says "could not convert string to float"
+            raise UserError(f"--grid {item!r} is invalid: {name} takes {_takes(config, name)}") from None
     return grid
+
+
+def _takes(config, name: str) -> str:
+    """What field ``name`` of ``config`` takes, in words, for a --grid value that is no such thing."""
+    from rlcore.allowed import field_words
+
+    f = next(f for f in dataclasses.fields(config) if f.name == name)
+    kind = {"int": "whole numbers", "float": "numbers", "tuple[int, ...]": "lists of whole numbers"}
+    words = field_words(f) or kind.get(str(f.type), str(f.type))
+    return words + (" (values apart with ';')" if str(f.type).startswith("tuple") else "")
 
 
 def check(sweep: Sweep) -> None:

@@ -295,6 +295,7 @@ def test_shipped_models_are_found_from_any_working_directory(capsys, tmp_path, m
     lander = get_experiment("lunar_lander")  # the task's number and ours, each named
     assert f"; the task's solved score {lander.solved_score:g}: " in out
     assert f"; the shipped model's bar ({lander.bar('dqn').describe()}): " in out
+    assert f"met (on 2 episodes, where it is judged on {lander.eval_episodes})" in out  # met or not met, qualified
     code, out, _ = run(capsys, "list")
     assert code == 0 and "1-1: flag in" in out and "shipped: " in out
 

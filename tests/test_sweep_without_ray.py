@@ -58,7 +58,8 @@ def test_seeds_and_grid_parsing():
 @pytest.mark.parametrize("argv, message", [
     (["sweep", "lunar_lander", "dqn", "--grid", "learning_rate=1e-3"], "'learning_rate' is not a hyperparameter"),
     (["sweep", "lunar_lander", "dqn", "--grid", "gamma=0.9,1.5"], "--gamma 1.5 is invalid"),
-    (["sweep", "lunar_lander", "dqn", "--grid", "lr=fast"], "--grid 'lr=fast' is invalid"),
+    (["sweep", "lunar_lander", "dqn", "--grid", "lr=fast"], "--grid 'lr=fast' is invalid: lr takes a number above 0"),
+    (["sweep", "lunar_lander", "dqn", "--grid", "batch_size=1.5"], "batch_size takes a whole number of at least 1"),
     (["sweep", "lunar_lander", "dqn", "--grid", "keep_best=maybe"], "--grid 'keep_best=maybe' is invalid: 'maybe'"),
     (["sweep", "lunar_lander", "dqn", "--seeds", "4-x"], "--seeds '4-x' is invalid"),
     (["sweep", "mario_ppo", "ppo", "--grid", "init_from=saved_networks/mario_ppo/1-1"],

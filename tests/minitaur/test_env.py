@@ -144,3 +144,16 @@ def test_gymnasium_checker_passes():
     check_env(env, skip_render_check=True)
     env.close()
     assert gym.spec(ENV_ID).entry_point is MinitaurEnv
+
+
+def test_an_env_never_closed_exits_quietly():
+    """A script that leaves its env open (a model card's snippet does) must not end in pybullet's
+    BulletClient.__del__ traceback, which fires when the interpreter has already torn pybullet down."""
+    import subprocess
+    import sys
+
+    script = ("from rlcore import api\n"  # with TensorFlow loaded, pybullet goes before the env at exit
+              "env = api.load(('minitaur', 'sac')).make_env()\nenv.reset(seed=0)\nprint('played')\n")
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0 and "played" in done.stdout
+    assert "Traceback" not in done.stderr and "Exception ignored" not in done.stderr, done.stderr
