@@ -73,19 +73,33 @@ def region_gif_strip(page: str, arg: str) -> str:
 
 
 def region_shipped(page: str, experiment: str) -> str:
-    """The shipped models of one experiment with their training counters and unseen-seed score."""
+    """The shipped models of one experiment with their training counters and unseen-seed score; a model
+    whose run started from another's weights (``--init-from``) also gives what the chain cost."""
+    models = [m for m in shipped_models() if m.experiment == experiment]
+    chained = any(m.lineage for m in models)
     rows = []
-    for m in shipped_models():
-        if m.experiment != experiment:
-            continue
+    for m in models:
         meta, best = m.meta, m.meta.get("best_eval") or {}
-        rows.append([f"[{m.name}]({link(page, card_path(m, page))})", f"`{meta.get('preset')}`",
-                     f"{meta['env_steps']:,}", f"{meta['episodes']:,}", hours(meta["wall_seconds"]),
-                     ret(best["mean"]) if "mean" in best else "–",
-                     f"**{score_text(m)}** ({m.evaluation.get('episodes', '?')} ep.)",
-                     f"{bar_text(m)}: {bar_met(m)}" if m.bar else "none set"])
-    return table(["model", "preset", "env steps", "episodes", "wall", "best selection eval",
-                  "unseen seeds", "bar"], rows, "llrrrrll")
+        row = [f"[{m.name}]({link(page, card_path(m, page))})", f"`{meta.get('preset')}`",
+               f"{meta['env_steps']:,}", f"{meta['episodes']:,}", hours(meta["wall_seconds"])]
+        if chained:
+            steps, seconds = m.from_scratch()
+            row.append(f"{steps:,}, {hours(seconds)} (from {', '.join(_source(p, m.name) for p in m.lineage)})"
+                       if m.lineage else "–")
+        rows.append(row + [ret(best["mean"]) if "mean" in best else "–",
+                           f"**{score_text(m)}** ({m.evaluation.get('episodes', '?')} ep.)",
+                           f"{bar_text(m)}: {bar_met(m)}" if m.bar else "none set"])
+    head = ["model", "preset", "env steps", "episodes", "wall"]
+    head += ["env steps, wall with the runs it started from (`--init-from`)"] if chained else []
+    return table(head + ["best selection eval", "unseen seeds", "bar"], rows,
+                 "llrrr" + ("r" if chained else "") + "rll")
+
+
+def _source(parent: dict, name: str) -> str:
+    """The model folder a run started from, by its last part (Mario's level): ``2-1``, or ``an earlier
+    2-2`` when it is the model's own folder as an earlier run left it."""
+    source = str(parent.get("path", "?")).rstrip("/").rsplit("/", 1)[-1]
+    return f"an earlier {source}" if source == name else source
 
 
 def region_sweeps(page: str, experiment: str) -> str:
@@ -149,16 +163,24 @@ def region_curves(page: str, experiment: str) -> str:
 
 def region_csv_columns(page: str, arg: str) -> str:
     """The columns of each CSV a shipped model folder holds (of experiment ARG, or all), read from the
-    files themselves."""
-    rows = {}
+    files themselves: every column any of them holds (a model trained before a column was added lacks
+    it; one marked * is in some of the files only)."""
+    seen: dict[tuple[str, str, str], list[list[str]]] = {}
     for m in shipped_models():
         if arg and m.experiment not in arg.split("/"):
             continue
         for csv_path in sorted((REPO / m.folder).glob("*.csv")):
-            header = csv_path.open().readline().strip()
-            rows.setdefault((m.experiment, csv_path.name), header)
-    return table(["experiment", "file", "columns"],
-                 [[e, f"`{f}`", ", ".join(f"`{c}`" for c in h.split(","))] for (e, f), h in rows.items()])
+            with csv_path.open() as f:
+                seen.setdefault((m.experiment, m.meta.get("kind", m.algo), csv_path.name), []).append(
+                    f.readline().strip().split(","))
+    rows = []
+    for (experiment, kind, name), headers in seen.items():
+        columns = list(dict.fromkeys(c for header in headers for c in header))
+        rows.append([experiment, kind, f"`{name}`", ", ".join(
+            f"`{c}`" + ("" if all(c in header for header in headers) else "*") for c in columns)])
+    partial = any(row[3].count("*") for row in rows)
+    return table(["experiment", "trainer", "file", "columns"], rows) + (
+        "\n\n\\* in some of the shipped models' files only: those trained before it was added lack it." if partial else "")
 
 
 def region_meta_keys(page: str, arg: str) -> str:

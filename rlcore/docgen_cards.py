@@ -146,6 +146,10 @@ def training_section(m: Model, page: str) -> str:
     rows = [["preset", f"`{meta.get('preset')}`"], ["seed", str(meta.get("seed"))],
             ["env steps", f"{meta['env_steps']:,}"], ["episodes", f"{meta['episodes']:,}"],
             ["wall time of training", f"{meta['wall_seconds']:,.0f} s ({meta['wall_seconds'] / 3600:.1f} h)"]]
+    if m.lineage:
+        steps, seconds = m.from_scratch()
+        rows.append([f"with the {len(m.lineage)} run{'s' if len(m.lineage) > 1 else ''} it started from",
+                     f"{steps:,} env steps, {seconds:,.0f} s ({seconds / 3600:.1f} h)"])
     if meta.get("stopped_by"):
         rows.append(["stopped by", stop_text(meta, m)])
     if meta.get("weights"):
@@ -156,14 +160,14 @@ def training_section(m: Model, page: str) -> str:
         rows.append(["finished", meta["finished"][:10]])
     text = table(["training", ""], rows) + "\n\nThe commands of the run, in order (each resume keeps the settings of the " \
                                    "checkpoint, except those it gives again):\n\n" + commands_table(commands) + "\n"
-    parent = meta.get("init_from")
-    if isinstance(parent, dict):
+    for i, parent in enumerate(m.lineage):
         pev = parent.get("evaluation") or {}
         score = (f"{round(pev['success_share'] * pev['episodes'])} of {pev['episodes']}" if "success_share" in pev
                  else ret(pev["mean"]) if "mean" in pev else "not evaluated")
-        text += (f"\nIt started from the weights of `{parent.get('path')}` (`--init-from`), a run of "
-                 f"{parent.get('env_steps', 0):,} env steps and {parent.get('wall_seconds', 0):,.0f} s "
-                 f"(its evaluation: {score}), trained by:\n\n" + commands_table(parent.get("commands") or []) + "\n")
+        text += (f"\n{'It' if i == 0 else 'That run in turn'} started from the weights of `{parent.get('path')}` "
+                 f"(`--init-from`), a run of {parent.get('env_steps', 0):,} env steps and "
+                 f"{parent.get('wall_seconds', 0):,.0f} s (its evaluation: {score}), trained by:\n\n"
+                 + commands_table(parent.get("commands") or []) + "\n")
     log = REPO / m.folder / "HOW_TRAINED.md"
     if log.is_file():
         text += f"\nThe training log, with what was seen and why each setting changed: [HOW_TRAINED.md]({link(page, m.folder + '/HOW_TRAINED.md')}).\n"

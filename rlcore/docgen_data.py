@@ -54,6 +54,21 @@ class Model:
         return self.meta.get("evaluation") or {}
 
     @property
+    def lineage(self) -> list[dict]:
+        """The runs whose weights this model's run started from (``--init-from``), nearest first, as
+        meta.json records them; empty for a model trained from scratch."""
+        chain, parent = [], self.meta.get("init_from")
+        while isinstance(parent, dict):
+            chain.append(parent)
+            parent = parent.get("init_from")
+        return chain
+
+    def from_scratch(self) -> tuple[int, float]:
+        """Env steps and wall seconds of this run and every run it started from: what the model cost."""
+        runs = [self.meta, *self.lineage]
+        return sum(r.get("env_steps", 0) for r in runs), sum(r.get("wall_seconds", 0.0) for r in runs)
+
+    @property
     def gif(self) -> str | None:
         path = f"{GIFS}/{self.slug}.gif"
         return path if (REPO / path).is_file() else None

@@ -176,4 +176,6 @@ def seed_runs(page: str, experiment: str) -> str:
                      + table(["seed", "unseen seeds", "further unseen seeds", "env steps", "wall", "env steps/s",
                               "stopped by"], rows, "rrrrrrl")
                      + f"\n\nOver the {len(runs)} seeds: {over_seeds_bold(m, '[95% CI] ')}." + seeds_bar_text(m))
-    return "\n\n".join([SEED_RUNS_INTRO, *parts]) if parts else ""  # nothing until a sweep is kept
+    if not parts:
+        return "*Not kept in `results/sweeps/` yet: the runs' table appears here when they are.*"
+    return "\n\n".join([SEED_RUNS_INTRO, *parts])
