@@ -146,18 +146,18 @@ def region_curves(page: str, experiment: str) -> str:
         pngs = sorted((REPO / m.folder).glob("*.png"))
         if pngs:
             parts.append(f"**{m.name}**\n\n" + "\n".join(
-                f"![{p.stem}]({link(page, m.folder + '/' + p.name)}){{ width=\"48%\" }}" for p in pngs))
+                f"![{p.stem}]({link(page, m.folder + '/' + p.name)})" for p in pngs))
         if m.sweep and (REPO / m.sweep.folder / "report_curves.png").is_file():
             parts.append(f"**{m.name}, {len(m.sweep.seeds)} seeds (IQM of the 100-episode average, 95% CI band)**"
-                         f"\n\n![{m.name} sweep]({link(page, m.sweep.folder + '/report_curves.png')}){{ width=\"60%\" }}")
+                         f"\n\n![{m.name} sweep]({link(page, m.sweep.folder + '/report_curves.png')})")
         if m.sweep and (REPO / m.sweep.folder / "report_evals.png").is_file():
             parts.append(f"**{m.name}, {len(m.sweep.seeds)} seeds: periodic evaluations on selection seeds (IQM, 95% CI "
                          f"band; each seed thin)**\n\n![{m.name} sweep evaluations]"
-                         f"({link(page, m.sweep.folder + '/report_evals.png')}){{ width=\"60%\" }}")
+                         f"({link(page, m.sweep.folder + '/report_evals.png')})")
         if m.sweep and (REPO / m.sweep.folder / "report_critic.png").is_file():
             parts.append(f"**{m.name}, {len(m.sweep.seeds)} seeds: each seed's mean Q of its training batches, "
                          f"running median of 20 episodes (log scale, linear within ±1)**\n\n![{m.name} sweep critic]"
-                         f"({link(page, m.sweep.folder + '/report_critic.png')}){{ width=\"60%\" }}")
+                         f"({link(page, m.sweep.folder + '/report_critic.png')})")
     return "\n\n".join(parts) or "*No curves shipped.*"
 
 

@@ -115,11 +115,9 @@ def article_of(experiment: str, algo: str | None = None) -> str:
 
 
 def link(page: str, target: str) -> str:
-    """A relative link from the file ``page`` to ``target`` (both repo-relative). In the docs site,
-    files outside docs/ (saved_networks/, results/) are served as if they lived under docs/
-    (rlcore/docgen_hooks.py), so a docs page links to them through that mount."""
-    if page.startswith("docs/") and not target.startswith("docs/"):
-        target = "docs/" + target
+    """A relative link from the file ``page`` to ``target`` (both repo-relative), true in the repository
+    (GitHub reads it as written); the docs site serves saved_networks/ and results/ as if under docs/,
+    and its hook points such links there (rlcore/docgen_hooks.py)."""
     return os.path.relpath(target, os.path.dirname(page) or ".").replace(os.sep, "/")
 
 
