@@ -111,16 +111,35 @@ def cmd_report(args) -> int:
             raise UserError("--keep copies one sweep: give one SWEEP_DIR with it")
         folders = [keep_runs(runs, Path(args.keep)) if runs else keep(folders[0], Path(args.keep))]
         print(f"kept: {folders[0]} (sweep.json; per run {', '.join(KEPT_FILES)}, where the run has them)")
+    out = _report_folder(folders, args.out)
     result = summarize(folders, reps=args.reps)
     text = markdown(result)
     print(text)
-    first = folders[0]
+    if out is None:
+        print("written: nothing (a report of several sweeps goes where --out DIR says; each sweep's own "
+              "report.md is left as it is)")
+        return 0
     from rlcore.atomic import write_atomic
-    write_atomic(first / "report.md", lambda p: p.write_text(text + "\n"))
-    pngs = [plot_curves(result, first / "report_curves.png"), plot_evals(result, first / "report_evals.png"),
-            plot_critic(result, first / "report_critic.png")]
+    write_atomic(out / "report.md", lambda p: p.write_text(text + "\n"))
+    pngs = [plot_curves(result, out / "report_curves.png"), plot_evals(result, out / "report_evals.png"),
+            plot_critic(result, out / "report_critic.png")]
     for name, png in (("report_evals.png", pngs[1]), ("report_critic.png", pngs[2])):
         if png is None:  # nothing to draw now: an earlier report's figure would describe other runs
-            (first / name).unlink(missing_ok=True)
-    print(f"written: {first / 'report.md'}, {', '.join(str(p) for p in pngs if p)}")
+            (out / name).unlink(missing_ok=True)
+    print(f"written: {out / 'report.md'}, {', '.join(str(p) for p in pngs if p)}")
     return 0
+
+
+def _report_folder(folders: list[Path], out: str | None) -> Path | None:
+    """Where a report goes: ``--out`` (made if missing), else the one sweep's folder; None for several
+    sweeps without ``--out`` (writing into the first would replace that sweep's own report)."""
+    if out is None:
+        return folders[0] if len(folders) == 1 else None
+    folder = Path(out)
+    if folder.is_file():
+        raise UserError(f"--out {out}: a file, not a folder")
+    if len(folders) > 1 and any(folder.resolve() == f.resolve() for f in folders):
+        raise UserError(f"--out {out} is one of the sweeps reported: its own report.md would be replaced by a "
+                        f"comparison; give another folder")
+    folder.mkdir(parents=True, exist_ok=True)
+    return folder

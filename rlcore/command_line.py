@@ -235,12 +235,16 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
                                         "(rliable's method); with two sweeps, P(first beats second). Where runs "
                                         "log a critic's Q (DQN family, SAC), each run's mean Q at its end beside "
                                         "its largest return. Writes report.md and report_curves.png into the "
-                                        "first sweep folder, with report_evals.png where runs evaluated "
-                                        "periodically and report_critic.png where they log Q.")
+                                        "sweep folder (several sweeps: into --out, else nothing is written), "
+                                        "with report_evals.png where runs evaluated periodically and "
+                                        "report_critic.png where they log Q.")
     report.add_argument("sweep_dirs", nargs="+", metavar="SWEEP_DIR",
                         help="a sweep's folder (several: one report, compared); with --keep, finished run "
                              "folders of one recipe over seeds (main.py train ... --seed S) may be given instead")
     report.add_argument("--reps", type=whole_number(Allowed(low=100, high=10**6)), default=5000, help="bootstrap resamples")
+    report.add_argument("--out", metavar="DIR", default=None,
+                        help="folder for report.md and its PNGs (default: the sweep's folder; a report of several "
+                             "sweeps is only printed without it, so no sweep's own report is replaced)")
     report.add_argument("--keep", metavar="DIR", default=None,
                         help="first copy sweep.json and, per run, model/meta.json, the model's .h5 files and "
                              "its CSV tables (not the checkpoints) into DIR, a folder git keeps such as "

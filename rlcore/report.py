@@ -226,7 +226,7 @@ def keep_runs(run_dirs: list[Path], dest: Path) -> Path:
     exp = get_experiment(first["experiment"])
     fields = exp.shipped_by.fields if exp.shipped_by else ()
     preset = json.loads(json.dumps(to_dict(exp.preset(first["algo"], first.get("preset")))))  # as meta.json has it
-    sweep = {"experiment": first["experiment"], "algo": first["algo"], "name": dest.name, "folder": str(dest.resolve()),
+    sweep = {"experiment": first["experiment"], "algo": first["algo"], "name": dest.name,
              "seeds": sorted(seeds), "grid": {}, "preset": first.get("preset"),
              # what the recipe set beside its preset (Mario: the level, the stop share, the precision)
              "overrides": {k: v for k, v in first["config"].items()

@@ -48,7 +48,7 @@ class Sweep:
     experiment: str
     algo: str
     name: str
-    folder: str  # absolute path of sweeps/<name>
+    folder: str  # absolute path of sweeps/<name>, where it is now: not written to sweep.json
     seeds: list[int]
     grid: dict[str, list] = field(default_factory=dict)  # hyperparameter -> values
     preset: str | None = None
@@ -64,7 +64,8 @@ class Sweep:
         return [{**dict(zip(names, values)), "seed": seed} for values in combos for seed in self.seeds]
 
     def save(self) -> None:
-        write_json(Path(self.folder) / SWEEP_FILE, asdict(self))
+        # the folder is where sweep.json lies; an absolute path would name this machine's checkout
+        write_json(Path(self.folder) / SWEEP_FILE, {k: v for k, v in asdict(self).items() if k != "folder"})
 
     @classmethod
     def load(cls, folder: Path) -> "Sweep":

@@ -43,6 +43,7 @@ def test_a_sweep_moved_to_another_folder_resumes_where_it_now_is(tmp_path):
     first = _sweep(tmp_path, "here")
     Path(first.folder).mkdir()
     first.save()
+    assert "folder" not in json.loads((tmp_path / "here" / "sweep.json").read_text())  # no machine's path kept
     (tmp_path / "here").rename(tmp_path / "there")
     assert Sweep.load(tmp_path / "there").folder == str((tmp_path / "there").resolve())
 
@@ -129,6 +130,30 @@ def test_report_keep_copies_what_the_report_reads_and_the_model_and_nothing_else
     assert [r["env_steps"] for r in load_runs(kept)] == [1000, 2000, 3000]
     code, _, err = run(capsys, "report", str(sweep), str(kept), "--keep", str(tmp_path / "other"))
     assert code == 2 and "--keep copies one sweep" in err and not (tmp_path / "other").exists()
+
+
+def _toy_sweep(folder: Path, scores) -> Path:
+    folder.mkdir(parents=True)
+    (folder / "sweep.json").write_text(json.dumps({"experiment": "toy"}))
+    for seed, score in enumerate(scores):
+        (folder / f"seed={seed}" / "model").mkdir(parents=True)
+        (folder / f"seed={seed}" / "model" / "meta.json").write_text(json.dumps({
+            "seed": seed, "env_steps": 100, "wall_seconds": 1.0, "evaluation": {"episodes": 5, "mean": score}}))
+        (folder / f"seed={seed}" / "metrics.csv").write_text("episode,env_steps,av_latest_points\n1,100,%s\n" % score)
+    return folder
+
+
+def test_a_report_of_two_sweeps_leaves_each_sweeps_own_report_alone(tmp_path, capsys):
+    first, second = _toy_sweep(tmp_path / "a", (1.0, 2.0, 3.0)), _toy_sweep(tmp_path / "b", (4.0, 5.0, 6.0))
+    (first / "report.md").write_text("a's own report")
+    code, out, err = run(capsys, "report", str(first), str(second), "--reps", "100")
+    assert code == 0, err
+    assert "P(" in out and "written: nothing" in out and (first / "report.md").read_text() == "a's own report"
+    code, out, err = run(capsys, "report", str(first), str(second), "--reps", "100", "--out", str(tmp_path / "both"))
+    assert code == 0 and (tmp_path / "both" / "report.md").is_file() and (first / "report.md").read_text() == "a's own report"
+    code, _, err = run(capsys, "report", str(first), str(second), "--out", str(second))
+    assert code == 2 and "--out" in err and "is one of the sweeps reported" in err and not (second / "report.md").exists()
+    assert run(capsys, "report", str(second), "--reps", "100")[0] == 0 and (second / "report.md").is_file()  # one: its own
 
 
 def test_report_tells_each_runs_collapses_and_which_weights_its_model_holds(tmp_path):
