@@ -34,8 +34,12 @@ class ParityError(UserError):
 
 
 # ------------------------------------------------------------------------------ observations
+MAX_PARITY_EPISODES = 50  # episodes played at most to collect the observations asked for
+
+
 def collect_observations(exp, policy, count: int, episodes: int = 3) -> tuple[np.ndarray, str]:
-    """``count`` observations spread evenly over ``episodes`` episodes of the model's own env, on the
+    """``count`` observations spread evenly over ``episodes`` episodes of the model's own env, or more
+    episodes where those end before ``count`` steps (up to :data:`MAX_PARITY_EPISODES`), on the
     experiment's first evaluation seeds, played as the model is evaluated (greedy; Mario samples
     from pi with the episode's seeded RNG). Returns the observations and the seeds as text."""
     if count < 1 or episodes < 1:
@@ -44,7 +48,8 @@ def collect_observations(exp, policy, count: int, episodes: int = 3) -> tuple[np
     sampled = exp.goal is not None and getattr(policy, "stochastic", False)
     seen = []
     try:
-        for episode in range(episodes):
+        episode = 0
+        while episode < episodes or (len(seen) < count and episode < MAX_PARITY_EPISODES):
             seed = exp.eval_seed_base + episode
             rng = np.random.default_rng(seed)
             obs, _ = env.reset(seed=seed)
@@ -55,10 +60,11 @@ def collect_observations(exp, policy, count: int, episodes: int = 3) -> tuple[np
                 obs, _, terminated, truncated, _ = env.step(action)
                 if terminated or truncated:
                     break
+            episode += 1
     finally:
         env.close()
     picks = np.linspace(0, len(seen) - 1, min(count, len(seen))).round().astype(int)
-    seeds = f"{exp.eval_seed_base}..{exp.eval_seed_base + episodes - 1}"
+    seeds = f"{exp.eval_seed_base}..{exp.eval_seed_base + episode - 1}"
     return np.stack([seen[i] for i in picks]).astype(policy.dtype), seeds
 
 

@@ -117,3 +117,32 @@ def test_bad_formats_and_outputs_are_refused_before_any_work(tmp_path):
     with pytest.raises(UserError, match="not an export"):
         export.export_model(folder, "onnx", tmp_path / "busy")
     assert (tmp_path / "busy" / "notes.txt").read_text() == "mine"
+
+
+def test_short_episodes_are_followed_by_more_until_the_observations_asked_for():
+    """An env whose episodes end in 5 steps still gives the parity check the 64 observations asked for
+    (3 such episodes gave 15 and the check said nothing), from more evaluation seeds, named."""
+    import types
+
+    import gymnasium as gym
+
+    class Short(gym.Env):
+        observation_space = gym.spaces.Box(-1.0, 1.0, (2,), np.float32)
+        action_space = gym.spaces.Discrete(2)
+
+        def reset(self, *, seed=None, options=None):
+            super().reset(seed=seed)
+            self.t = 0
+            return np.full(2, seed % 7, np.float32), {}
+
+        def step(self, action):
+            self.t += 1
+            return np.full(2, self.t, np.float32), 0.0, self.t >= 5, False, {}
+
+    exp = types.SimpleNamespace(eval_seed_base=1_000_000, goal=None)
+    policy = type("P", (), {"make_env": staticmethod(Short), "dtype": np.float32,
+                            "__call__": lambda self, batch: np.zeros(len(batch), int)})()
+    obs, seeds = collect_observations(exp, policy, count=64, episodes=3)
+    assert len(obs) == 64 and seeds == "1000000..1000012"  # 13 episodes of 5 steps: 65 observations seen
+    obs, seeds = collect_observations(exp, policy, count=4, episodes=3)
+    assert len(obs) == 4 and seeds == "1000000..1000002"  # never fewer episodes than asked
