@@ -70,7 +70,7 @@ def train(env: str, algo: str, *, preset: str | None = None, seed: int = 0,
     from rlcore.trainers.spec import new_run_dir
 
     check_whole("seed", seed, RUN_SEEDS)  # as the command line checks them, before any folder exists
-    _check_budgets(episodes, steps, final_eval_episodes)
+    _check_budgets(episodes, steps, final_eval_episodes, wandb)
     require_experiment(env)  # a missing extra (mario, minitaur): one line, before any folder exists
     load_tensorflow()
     overrides = _overrides(hyperparameters, episodes, steps)
@@ -106,7 +106,7 @@ def resume(run: str | os.PathLike[str] | Run, *, episodes: int | None = None, st
     from rlcore.run import build_spec
     from rlcore.trainers.spec import CHECKPOINT_FILE
 
-    _check_budgets(episodes, steps, final_eval_episodes)
+    _check_budgets(episodes, steps, final_eval_episodes, wandb)
     folder = Path(run.run_dir if isinstance(run, Run) else run)
     if not (folder / CHECKPOINT_FILE).is_file():
         raise UserError(f"{folder} holds no {CHECKPOINT_FILE} to resume from; give the folder of a run "
@@ -124,9 +124,15 @@ def resume(run: str | os.PathLike[str] | Run, *, episodes: int | None = None, st
                                      f"{state['env_steps']}{resuming_changes(spec.changes)}", callback, progress)
 
 
-def _check_budgets(episodes: int | None, steps: int | None, final_eval_episodes: int | None) -> None:
+def _check_budgets(episodes: int | None, steps: int | None, final_eval_episodes: int | None,
+                   wandb: str | None = None) -> None:
     """``episodes``, ``steps`` and ``final_eval_episodes`` as ``--episodes``, ``--steps`` and
-    ``--final-eval-episodes`` are checked (None: not given)."""
+    ``--final-eval-episodes`` are checked (None: not given), and ``wandb`` as ``--wandb``'s choices: before
+    anything is printed or made."""
+    from rlcore.tracking import WANDB_MODES
+
+    if wandb is not None and wandb not in WANDB_MODES:
+        raise UserError(f"wandb={wandb!r} is invalid: choose one of {', '.join(map(repr, WANDB_MODES))}")
     for name, value, allowed in (("episodes", episodes, COUNT), ("steps", steps, COUNT),
                                  ("final_eval_episodes", final_eval_episodes, FINAL_EVALUATION)):
         if value is not None:

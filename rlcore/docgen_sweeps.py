@@ -139,24 +139,10 @@ def evaluation_cell(evaluation: dict, m) -> str:
 
 
 def stop_text(meta: dict, m) -> str:
-    """What ended a run, in words (meta.json's ``stopped_by`` names the rule and its value: ``max_env_steps
-    1000000`` -> ``its budget of 1,000,000 env steps``); a rule not known here, as recorded."""
-    from rlcore.score_words import success_word
+    """What ended the run of ``meta``, a run of model ``m``, in words (:func:`rlcore.score_words.stop_words`)."""
+    from rlcore.score_words import stop_words
 
-    recorded = meta.get("stopped_by") or ""
-    rule, _, value = recorded.partition(" ")
-    window = (meta.get("config") or {}).get("window", 100)
-    try:
-        number = float(value)
-    except ValueError:
-        return recorded or "–"
-    texts = {"max_env_steps": f"its budget of {number:,.0f} env steps",
-             "max_episodes": f"its budget of {number:,.0f} episodes",
-             "stop_eval_score": f"a periodic evaluation of {num(number)} or more",
-             "stop_score": f"a {window}-episode average of {num(number)} or more",
-             "stop_success_share": f"reached the {success_word(m.experiment, m.name)} in {number * 100:g}% or more of the last {window} "
-                                   f"training episodes from the start"}
-    return texts.get(rule, recorded)
+    return stop_words(meta.get("stopped_by") or "", m.experiment, m.name, (meta.get("config") or {}).get("window", 100))
 
 
 def seed_runs(page: str, experiment: str) -> str:

@@ -8,16 +8,11 @@ import re
 
 from rlcore.docgen_data import Model
 from rlcore.experiment import get_experiment
-from rlcore.score_words import return_digits, score_words
+from rlcore.score_words import hours, return_digits, score_words  # noqa: F401 (hours: the docs' parts import it here)
 
 
 def num(value: float, digits: int = 1) -> str:
     return f"{value:,.{digits}f}"
-
-
-def hours(seconds: float) -> str:
-    """A wall time as the tables write it: ``3.1 h`` from an hour up, else ``725 s``."""
-    return f"{seconds / 3600:.1f} h" if seconds >= 3600 else f"{seconds:,.0f} s"
 
 
 def ret(value: float, near: float | None = None) -> str:

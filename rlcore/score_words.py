@@ -1,6 +1,6 @@
-"""A shipped model's recorded evaluation in words, one rule for the README, the model cards and the
-console (``main.py list``): ``270.7 ± 21.4``, ``20.45 ± 3.99`` or ``flag in 8 of 10``. Plain Python: it
-reads a meta.json's ``evaluation`` and names only."""
+"""A run's records in words, one rule for the README, the model cards and the console (``main.py list``,
+``status``): a recorded evaluation (``270.7 ± 21.4``, ``20.45 ± 3.99`` or ``flag in 8 of 10``), what
+stopped a run, a wall time. Plain Python: it reads a meta.json's fields and names only."""
 from __future__ import annotations
 
 
@@ -25,3 +25,26 @@ def score_words(evaluation: dict, experiment: str, name: str, plus_minus: str = 
 def return_digits(mean: float) -> int:
     """Decimals of a return near ``mean``: one from 100 up, two below (Minitaur's 20.45)."""
     return 1 if abs(mean) >= 100 else 2
+
+
+def hours(seconds: float) -> str:
+    """A wall time as the tables write it: ``3.1 h`` from an hour up, else ``725 s``."""
+    return f"{seconds / 3600:.1f} h" if seconds >= 3600 else f"{seconds:,.0f} s"
+
+
+def stop_words(recorded: str, experiment: str, name: str, window: int = 100) -> str:
+    """What ended a run, in words (meta.json's ``stopped_by`` names the rule and its value: ``max_env_steps
+    1000000`` -> ``its budget of 1,000,000 env steps``); a rule not known here, as recorded. ``name``: the
+    model's (Mario's level, for what its success reaches); ``window``: the run's averaging window."""
+    rule, _, value = (recorded or "").partition(" ")
+    try:
+        number = float(value)
+    except ValueError:
+        return recorded or "–"
+    texts = {"max_env_steps": f"its budget of {number:,.0f} env steps",
+             "max_episodes": f"its budget of {number:,.0f} episodes",
+             "stop_eval_score": f"a periodic evaluation of {number:,.1f} or more",
+             "stop_score": f"a {window}-episode average of {number:,.1f} or more",
+             "stop_success_share": f"the {success_word(experiment, name)} reached in {number * 100:g}% or more of the "
+                                   f"last {window} training episodes from the start"}
+    return texts.get(rule, recorded)

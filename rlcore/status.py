@@ -22,6 +22,8 @@ import pandas as pd
 
 from rlcore.evaluation import count_causes
 from rlcore.plotting import full_episodes, read_table
+from rlcore.score_words import hours, stop_words
+from rlcore.shipping import model_name
 
 
 def run_status(run_dir: str | Path, experiment, about: dict, block: int = 200,
@@ -33,7 +35,7 @@ def run_status(run_dir: str | Path, experiment, about: dict, block: int = 200,
     df = read_table(Path(run_dir) / "metrics.csv", "episode", "env_steps", "total_points")
     pace = pace_text(Path(run_dir) / "metrics.csv", about) if "returns" in about else None  # a checkpoint's
     goal = goal_line(about, experiment) if "returns" in about else None
-    lines = [headline(about) + (f"; {pace}" if pace else "")] + resumes_lines(about) + ([goal] if goal else [])
+    lines = [headline(about, experiment) + (f"; {pace}" if pace else "")] + resumes_lines(about) + ([goal] if goal else [])
     full = full_episodes(df, experiment.curriculum.partial_key if experiment.curriculum else None)
     recent = full.tail(block * blocks)
     if recent.empty:
@@ -47,15 +49,16 @@ def run_status(run_dir: str | Path, experiment, about: dict, block: int = 200,
             + evaluation_lines(Path(run_dir) / "evals.csv"))
 
 
-def headline(about: dict) -> str:
+def headline(about: dict, experiment) -> str:
     """What the run is and how far it got."""
     episodes = about.get("episodes", len(about.get("returns", [])))
     where = "checkpoint" if "returns" in about else "model"  # a checkpoint's state keeps every return
     text = (f"{about['experiment']} {about['algo']} ({about.get('preset', '?')} preset, "
             f"seed {about.get('seed', '?')}): {where} at {about['env_steps']:,} env steps, "
-            f"{episodes:,} episodes, {about.get('wall_seconds', 0) / 3600:.1f} h of training")
+            f"{episodes:,} episodes, {hours(about.get('wall_seconds', 0))} of training")
     if "stopped_by" in about:
-        text += f"; stopped by {about['stopped_by']}"
+        text += "; stopped by " + stop_words(about["stopped_by"], about["experiment"], model_name(experiment, about),
+                                             (about.get("config") or {}).get("window", 100))
     return text
 
 

@@ -53,7 +53,7 @@ def test_load_mistakes_are_user_errors(model, message):
     ({"seed": -1}, "seed=-1 is invalid: allowed is a whole number from 0 to 900"),
     ({"seed": 901}, "seed=901 is invalid"), ({"seed": 2.5}, "seed=2.5 is invalid"), ({"seed": "3"}, "seed='3' is invalid"),
     ({"final_eval_episodes": -1}, "final_eval_episodes=-1 is invalid"), ({"episodes": 0}, "episodes=0 is invalid"),
-    ({"steps": True}, "steps=True is invalid"),
+    ({"steps": True}, "steps=True is invalid"), ({"wandb": "bogus"}, "^wandb='bogus' is invalid: choose one of 'auto'"),
     # hyperparameters are named as the call gives them, not as the command line's flags
     ({"lr": -1.0}, "^lr=-1.0 is invalid: allowed is a number above 0$"),
     ({"hidden": 64}, "^hidden=64 is invalid: allowed is a list or tuple, each item a whole number of at least 1$"),
@@ -63,15 +63,16 @@ def test_load_mistakes_are_user_errors(model, message):
     ({"eps_decay": 0.9}, r"^eps_decay does nothing here: it is the factor of eps_schedule='episode'"),
     ({"lrr": 0.1}, "^unknown hyperparameter.s. lrr for DQNConfig; did you mean lr\\? known: "),
 ])
-def test_train_checks_its_arguments_as_the_command_line_does_before_any_folder_exists(tmp_path, kwargs, message):
+def test_train_checks_its_arguments_as_the_command_line_does_before_any_folder_exists(tmp_path, kwargs, message,
+                                                                                    capsys):
     from rlcore.allowed import check_whole
     from rlcore.command_line import RUN_SEEDS
 
     check_whole("seed", np.int64(3), RUN_SEEDS)  # numpy's integers are whole numbers too
     with pytest.raises(UserError, match=message):
         api.train("cartpole", "dqn", run_dir=tmp_path / "run", **{"episodes": 2, **kwargs})
-    assert not (tmp_path / "run").exists()
-    if set(kwargs) <= {"episodes", "steps", "final_eval_episodes"}:  # resume takes the budgets too, and
+    assert not (tmp_path / "run").exists() and "training" not in capsys.readouterr().out  # no header first
+    if set(kwargs) <= {"episodes", "steps", "final_eval_episodes", "wandb"}:  # resume takes the budgets too, and
         # checks them before it reads the folder
         with pytest.raises(UserError, match=message):
             api.resume(tmp_path / "run", **kwargs)

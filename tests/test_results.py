@@ -65,7 +65,7 @@ def test_the_experiment_page_tells_each_kept_sweeps_collapses_as_its_evaluations
     experiment, model = name.split("__")
     page = (ROOT / "docs" / "experiments" / f"{experiment}.md").read_text()
     region = page.partition("<!-- generated:sweep-stability")[2].partition("<!-- /generated -->")[0]
-    section = region.partition(f"**[{model}](../results/sweeps/{name}/report.md)**: ")[2].partition("\n**[")[0]
+    section = region.partition(f"**[{model}](../../results/sweeps/{name}/report.md)**: ")[2].partition("\n**[")[0]
     runs = load_runs(KEPT / name)
     if not any(r["story"].evaluations for r in runs):  # PPO's runs (Mario) evaluate only at their end
         assert not section or "made no periodic evaluations" in section, section
@@ -151,8 +151,8 @@ def test_what_ended_a_run_is_said_in_words_and_an_unknown_rule_as_recorded():
             "max_episodes 600": "its budget of 600 episodes",
             "stop_eval_score 250.0": "a periodic evaluation of 250.0 or more",
             "stop_score 230.0": "a 50-episode average of 230.0 or more",
-            "stop_success_share 0.9": "reached the flag in 90% or more of the last 50 training episodes from the start",
-            "stop_success_share 0.825": "reached the flag in 82.5% or more of the last 50 training episodes from the start",
+            "stop_success_share 0.9": "the flag reached in 90% or more of the last 50 training episodes from the start",
+            "stop_success_share 0.825": "the flag reached in 82.5% or more of the last 50 training episodes from the start",
             "a_new_rule 3": "a_new_rule 3", "nonsense": "nonsense"}
     for recorded, words in said.items():
         assert stop_text({"stopped_by": recorded, "config": {"window": 50}}, mario) == words

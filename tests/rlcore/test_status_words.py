@@ -1,0 +1,18 @@
+"""``main.py status``'s headline in words: what stopped a run, as the cards say it, and a short run's
+wall time in seconds (a 393 s run read '0.1 h', a 122 s one '0.0 h')."""
+from __future__ import annotations
+
+from rlcore.experiment import get_experiment
+from rlcore.status import headline
+
+
+def test_a_finished_runs_headline_says_what_stopped_it_in_words():
+    lander = {"experiment": "lunar_lander", "algo": "dqn", "preset": "default", "seed": 0, "env_steps": 475_111,
+              "episodes": 1_030, "wall_seconds": 122.4, "stopped_by": "stop_eval_score 250.0", "config": {}}
+    assert headline(lander, get_experiment("lunar_lander")) == (
+        "lunar_lander dqn (default preset, seed 0): model at 475,111 env steps, 1,030 episodes, 122 s of training; "
+        "stopped by a periodic evaluation of 250.0 or more")
+    castle = {**lander, "experiment": "mario_ppo", "algo": "ppo", "wall_seconds": 11_331.0,
+              "stopped_by": "stop_success_share 0.9", "config": {"world": 1, "stage": 4, "window": 100}}
+    assert headline(castle, get_experiment("mario_ppo")).endswith(
+        "3.1 h of training; stopped by the axe reached in 90% or more of the last 100 training episodes from the start")
