@@ -15,8 +15,22 @@ from rlcore.allowed import Allowed, whole_number
 from rlcore.seeding import MAX_EVAL_EPISODES, MAX_RUN_SEED
 
 
+# the names Stable-Baselines3, RL Zoo and CleanRL give these settings -> ours, each where a command has it
+# (--learning-rate is nearest --learning-starts by spelling, which is another setting)
+OTHER_NAMES = {"--learning-rate": ("--lr", "--actor-lr", "--critic-lr"), "--n-envs": ("--num-envs",), "--num-steps": ("--n-steps",),
+               "--total-timesteps": ("--steps",), "--n-timesteps": ("--steps",), "--n-epochs": ("--epochs",),
+               "--update-epochs": ("--epochs",), "--ent-coef": ("--entropy-coef",), "--vf-coef": ("--value-coef",),
+               "--clip-range": ("--clip",), "--clip-coef": ("--clip",), "--batch": ("--batch-size", "--minibatch"),
+               "--num-minibatches": ("--minibatch",), "--max-grad": ("--max-grad-norm",), "--env": ("EXPERIMENT",),
+               "--env-id": ("EXPERIMENT",), "--algo": ("ALGO",), "--net-arch": ("--hidden", "--actor-hidden", "--critic-hidden")}
+
+
 def _nearest(flag: str, options) -> list[str]:
-    """The one flag ``flag`` begins (``--epi``: ``--episodes``), else the closest spelling (``--gama``), else none."""
+    """Ours for another library's name (``--learning-rate``: ``--lr``), else the one flag ``flag`` begins
+    (``--epi``: ``--episodes``), else the closest spelling (``--gama``), else none."""
+    ours = [name for name in OTHER_NAMES.get(flag, ()) if name in options or name.isupper()]
+    if ours:
+        return [f"the positional {name}" if name.isupper() else name for name in ours]
     starting = [option for option in options if option.startswith(flag)]
     return starting if len(starting) == 1 else difflib.get_close_matches(flag, list(options), n=1, cutoff=0.75)
 

@@ -49,7 +49,11 @@ def dqn_model_dir(tmp_path):
     (["train", "moon_lander", "dqn"], "unknown experiment 'moon_lander'"),
     (["train", "lunar_lander", "dqn3"], "unknown algorithm 'dqn3'"),
     (["train", "lunar_lander", "dqn", "--preset", "fastest"], "unknown preset 'fastest'"),
-    (["train", "lunar_lander", "dqn", "--learning-rate", "1"], "unrecognized arguments: --learning-rate"),
+    (["train", "lunar_lander", "dqn", "--learning-rate", "1"],  # Stable-Baselines3's name, not --learning-starts
+     "unrecognized arguments: --learning-rate 1; did you mean --lr? "),
+    (["train", "cartpole", "a2c", "--n-envs", "4", "--total-timesteps", "9"],
+     "unrecognized arguments: --n-envs 4 --total-timesteps 9; did you mean --num-envs, --steps? "),
+    (["train", "lunar_lander", "dqn", "--env", "x"], "did you mean the positional EXPERIMENT? "),
     (["train", "lunar_lander", "dqn", "--gama", "0.9"],
      "unrecognized arguments: --gama 0.9; did you mean --gamma? (see `main.py train EXPERIMENT ALGO --help`)"),
     (["evaluate", "cartpole", "a2c", "--epi", "3"],  # no abbreviation is taken for a flag
