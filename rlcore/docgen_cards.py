@@ -148,7 +148,7 @@ def training_section(m: Model, page: str) -> str:
             ["wall time of training", f"{meta['wall_seconds']:,.0f} s ({meta['wall_seconds'] / 3600:.1f} h)"]]
     if m.lineage:
         steps, seconds = m.from_scratch()
-        rows.append([f"with the {len(m.lineage)} run{'s' if len(m.lineage) > 1 else ''} it started from",
+        rows.append([f"with the {len(m.lineage)} runs it started from" if len(m.lineage) > 1 else "with the run it started from",
                      f"{steps:,} env steps, {seconds:,.0f} s ({seconds / 3600:.1f} h)"])
     if meta.get("stopped_by"):
         rows.append(["stopped by", stop_text(meta, m)])
@@ -241,7 +241,7 @@ def model_pages(models: list[Model]) -> dict[str, str]:
         f"Every shipped model has a card: its score on unseen seeds, how to use it, every command that trained "
         f"it, and its files. The same card sits beside the model as `saved_networks/.../README.md`, with "
         f"front matter the Hugging Face Hub reads.", "",
-        table(["model", "env", "algorithm", "score on unseen seeds", "bar", "", OVER_SEEDS_HEADER, "GIF"], rows),
+        table(["model", "env", "algorithm", "score on unseen seeds", "bar", "bar met", OVER_SEEDS_HEADER, "GIF"], rows),
         ""])
     return out
 
