@@ -248,8 +248,11 @@ def _rollout_line(experiment, part: pd.DataFrame) -> str:
                              for name in ("episodes", "successes"))
     from_start, wins = int(part["episodes_ended"].sum() - partial), int(part["successes"].sum())
     words = [f"rollouts {int(part['rollout'].iloc[0])}-{int(part['rollout'].iloc[-1])}:"]
-    label = (experiment.goal.success_key if experiment.goal else None) or "success"
-    words.append(f"{label} {wins}/{from_start}" + (f" ({wins / from_start:.1%})" if from_start else ""))
+    if experiment.goal:  # a task without a success event (CartPole-v1 on PPO) has no share to give
+        words.append(f"{experiment.goal.success_key} {wins}/{from_start}"
+                     + (f" ({wins / from_start:.1%})" if from_start else ""))
+    else:
+        words.append(f"{from_start} episodes ended")
     if partial:
         words.append(f"| {key} {int(partial_wins)}/{int(partial)} ({partial_wins / partial:.1%})")
     sizes = [f"{shown} {part[name].mean():.{digits}f}"

@@ -16,3 +16,14 @@ def test_a_finished_runs_headline_says_what_stopped_it_in_words():
               "stopped_by": "stop_success_share 0.9", "config": {"world": 1, "stage": 4, "window": 100}}
     assert headline(castle, get_experiment("mario_ppo")).endswith(
         "3.1 h of training; stopped by the axe reached in 90% or more of the last 100 training episodes from the start")
+
+
+def test_rollouts_of_a_task_without_a_success_event_give_no_success_share(tmp_path):
+    """PPO on CartPole-v1 logs rollouts.csv too; its blocks said 'success 0/1024' of a goal it has none of."""
+    from rlcore.gym_experiment import gym_experiment
+    from rlcore.status import rollout_lines
+
+    rows = ["rollout,env_steps,episodes_ended,successes,entropy"] + [f"{r},{512 * r},{20 + r},0,0.6" for r in (1, 2)]
+    (tmp_path / "rollouts.csv").write_text("\n".join(rows) + "\n")
+    (line,) = rollout_lines(tmp_path / "rollouts.csv", gym_experiment("CartPole-v1"), block=2, blocks=1)
+    assert line == "rollouts 1-2: 43 episodes ended | entropy 0.60"
