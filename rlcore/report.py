@@ -84,7 +84,7 @@ def load_runs(sweep_dir: Path) -> list[dict]:
         rows.append({"trial": meta_path.parent.parent.name, "seed": meta["seed"], "score": float(score),
                      "eval_episodes": ev.get("episodes"), "env_steps": meta["env_steps"],
                      "wall_seconds": meta["wall_seconds"], "run_dir": meta_path.parent.parent,
-                     "cpu": meta.get("cpu"), "time_limit_share": ev.get("time_limit_share"),
+                     "cpu": cpus_text(meta), "time_limit_share": ev.get("time_limit_share"),
                      "further": [(f["episodes"], f.get("success_share", f.get("mean")))
                                  for f in meta.get("further_evaluations", [])],
                      "story": story(meta_path.parent.parent, meta, _solved_score(meta)),
@@ -165,6 +165,21 @@ def _keep_into(dest: Path, pairs: list[tuple[Path, str]], sweep: dict | None = N
 
 #: config fields kept runs may differ in: budgets, which a resume may give again (the stop rule ends a run)
 BUDGETS = ("max_env_steps", "max_episodes")
+
+
+def cpus_text(meta: dict) -> str | None:
+    """The CPUs a run trained on: meta.json's ``cpu`` (the last command's machine), or where its commands
+    recorded theirs (from 2026-11-29 on) and a resume moved the run to another CPU, each with where it
+    took over: ``AMD EPYC (...); Intel Xeon (...) from 614,400 env steps``."""
+    changes: list[tuple[int, str]] = []
+    for start in command_starts(meta):
+        cpu = (start or {}).get("cpu")
+        if cpu and (not changes or changes[-1][1] != cpu):
+            changes.append((int(start.get("env_steps", 0)), cpu))
+    if len(changes) < 2:
+        return meta.get("cpu") or (changes[0][1] if changes else None)
+    return "; ".join(cpu if i == 0 and steps == 0 else f"{cpu} from {steps:,} env steps"
+                     for i, (steps, cpu) in enumerate(changes))
 
 
 def command_starts(record: dict) -> list:

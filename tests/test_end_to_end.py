@@ -61,8 +61,11 @@ def test_mario_ppo_through_the_process_pool_survives_kill_9_and_resumes(tmp_path
     assert steps[-1] == budget and np.all(np.diff(steps) == 128)
     final = read_checkpoint_state(run_dir / "checkpoint.npz")
     assert final["rollouts"] == state["rollouts"] + 2
+    from rlcore.cpu import cpu_description
+
     assert final["command_starts"][-1] == {"env_steps": state["env_steps"], "episodes": len(state["returns"]),
-                                           "rollouts": state["rollouts"],
+                                           "wall_seconds": round(float(state["wall_seconds"]), 1),
+                                           "cpu": cpu_description(), "rollouts": state["rollouts"],
                                            "changed": {"max_env_steps": [100000, budget]}}  # what the resume changed
     # the resumed pool got the routes back and kept them (the envs replay them from the level's start)
     assert {name.split("/")[3] for name in route_keys(run_dir / "checkpoint.npz")} >= \

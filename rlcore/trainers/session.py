@@ -27,6 +27,7 @@ import time
 from pathlib import Path
 
 from rlcore.atomic import writable_folder
+from rlcore.cpu import cpu_description
 from rlcore.seeding import training_env_seed
 from rlcore.tracking import Tracker
 from rlcore.trainers.episodes import EpisodeBook
@@ -53,12 +54,14 @@ class TrainingSession:
         # the command that started the run, then one per resume; beside each, where it took effect
         # (None for the commands of checkpoints written before 2026-11-27, which did not record it) and,
         # for a resume, the hyperparameters it changed (``changed``: name -> [before, after]; recorded
-        # from 2026-11-27 on; `report --keep` of single runs reads it)
+        # from 2026-11-27 on; `report --keep` of single runs reads it), and the wall seconds before it and
+        # the CPU it ran on (from 2026-11-29: a run resumed on other machines has a pace per CPU)
         earlier = list(state.get("commands", []))
         starts = list(state.get("command_starts") or [])
         self.commands = earlier + [spec.command]
         self.command_starts = ([None] * (len(earlier) - len(starts)) + starts
                                + [{"env_steps": self.env_steps, "episodes": self.book.episodes,
+                                   "wall_seconds": round(self._wall_before, 1), "cpu": cpu_description(),
                                    **({"rollouts": int(state["rollouts"])} if "rollouts" in state else {}),
                                    **({"changed": dict(spec.changes)} if resumed_state else {})}])
         self.evaluation = PeriodicEvaluation(cfg, state)

@@ -27,3 +27,14 @@ def test_rollouts_of_a_task_without_a_success_event_give_no_success_share(tmp_pa
     (tmp_path / "rollouts.csv").write_text("\n".join(rows) + "\n")
     (line,) = rollout_lines(tmp_path / "rollouts.csv", gym_experiment("CartPole-v1"), block=2, blocks=1)
     assert line == "rollouts 1-2: 43 episodes ended | entropy 0.60"
+
+
+def test_a_run_resumed_on_another_cpu_names_each_with_where_it_took_over():
+    from rlcore.report import cpus_text
+
+    epyc, xeon = "AMD EPYC (avx2 avx512_bf16)", "Intel Xeon (avx2 avx512f)"
+    starts = [{"env_steps": 0, "cpu": epyc}, {"env_steps": 286_720, "cpu": epyc}, {"env_steps": 614_400, "cpu": xeon}]
+    assert cpus_text({"cpu": xeon, "command_starts": starts}) == f"{epyc}; {xeon} from 614,400 env steps"
+    assert cpus_text({"cpu": epyc, "command_starts": starts[:2]}) == epyc  # one CPU throughout
+    assert cpus_text({"cpu": xeon, "command_starts": [None, {"env_steps": 9}]}) == xeon  # older records: meta's
+    assert cpus_text({}) is None
