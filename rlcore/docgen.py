@@ -176,10 +176,10 @@ def region_csv_columns(page: str, arg: str) -> str:
     rows = []
     for (experiment, kind, name), headers in seen.items():
         columns = list(dict.fromkeys(c for header in headers for c in header))
-        rows.append([experiment, kind, f"`{name}`", ", ".join(
+        rows.append([f"`{name}`", experiment, kind, ", ".join(
             f"`{c}`" + ("" if all(c in header for header in headers) else "*") for c in columns)])
     partial = any(row[3].count("*") for row in rows)
-    return table(["experiment", "trainer", "file", "columns"], rows) + (
+    return table(["file", "experiment", "trainer", "columns"], rows) + (
         "\n\n\\* in some of the shipped models' files only: those trained before it was added lack it." if partial else "")
 
 

@@ -40,7 +40,7 @@ def test_csv_columns_are_those_of_every_file(tmp_path, monkeypatch):
     monkeypatch.setattr(docgen, "REPO", tmp_path)
     monkeypatch.setattr(docgen, "shipped_models", lambda: [old, new])
     text = docgen.region_csv_columns("docs/x.md", "mario_ppo")
-    assert "| mario_ppo | ppo | `rollouts.csv` | `rollout`, `env_steps`, `loss`, `lr`* |" in text
+    assert "| `rollouts.csv` | mario_ppo | ppo | `rollout`, `env_steps`, `loss`, `lr`* |" in text
     assert "in some of the shipped models' files only" in text
     monkeypatch.setattr(docgen, "shipped_models", lambda: [new])
     assert "*" not in docgen.region_csv_columns("docs/x.md", "mario_ppo").replace("`", "")
