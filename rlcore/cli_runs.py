@@ -120,6 +120,7 @@ def cmd_report(args) -> int:
               "report.md is left as it is)")
         return 0
     from rlcore.atomic import write_atomic
+    out.mkdir(parents=True, exist_ok=True)  # after the summary: a sweep that cannot be read leaves no folder
     write_atomic(out / "report.md", lambda p: p.write_text(text + "\n"))
     pngs = [plot_curves(result, out / "report_curves.png"), plot_evals(result, out / "report_evals.png"),
             plot_critic(result, out / "report_critic.png")]
@@ -131,7 +132,7 @@ def cmd_report(args) -> int:
 
 
 def _report_folder(folders: list[Path], out: str | None) -> Path | None:
-    """Where a report goes: ``--out`` (made if missing), else the one sweep's folder; None for several
+    """Where a report goes: ``--out``, else the one sweep's folder; None for several
     sweeps without ``--out`` (writing into the first would replace that sweep's own report)."""
     if out is None:
         return folders[0] if len(folders) == 1 else None
@@ -141,5 +142,4 @@ def _report_folder(folders: list[Path], out: str | None) -> Path | None:
     if len(folders) > 1 and any(folder.resolve() == f.resolve() for f in folders):
         raise UserError(f"--out {out} is one of the sweeps reported: its own report.md would be replaced by a "
                         f"comparison; give another folder")
-    folder.mkdir(parents=True, exist_ok=True)
     return folder
