@@ -31,7 +31,8 @@ def main():
     args = parser.parse_args()
     from rlcore import experiment as registry
     from rlcore.run import build_spec, run_training
-    from rlcore.sweep import Sweep, run_sweep
+    from rlcore.sweep import Sweep
+    from rlcore.sweep_ray import run_sweep
 
     registry.EXPERIMENT_MODULES["toy"] = "tests.toy"
     budget = {"max_episodes": args.episodes, "stop_score": 99.0}

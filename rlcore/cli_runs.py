@@ -56,7 +56,8 @@ def cmd_sweep(args) -> int:
     from rlcore.experiment import get_experiment
     from rlcore.extras import require
     from rlcore.run import budget_overrides
-    from rlcore.sweep import Sweep, parse_grid, parse_seeds, run_sweep
+    from rlcore.sweep import Sweep, parse_grid, parse_seeds
+    from rlcore.sweep_ray import run_sweep
 
     require("ray.tune", "The sweep command")  # the sweep extra, or one line saying so
     exp = get_experiment(args.experiment)

@@ -18,7 +18,8 @@ def sweep_status(folder: str | Path) -> list[str]:
     score, stopped or running at a checkpoint with its pace and last periodic evaluation, or not
     started), then the hours of training left (:func:`time_left`). A trial whose tables are damaged
     gets its line without a pace, and the sweep no hours left."""
-    from rlcore.sweep import Sweep, final_metrics, trial_name
+    from rlcore.sweep import Sweep, trial_name
+    from rlcore.sweep_trial import final_metrics
 
     sweep = Sweep.load(Path(folder))
     trials = [trial_name(t) for t in sweep.trials()]

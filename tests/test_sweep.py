@@ -15,7 +15,8 @@ import pytest
 from rlcore import experiment as registry
 from rlcore.checkpoint import read_checkpoint_state
 from rlcore.report import load_runs, summarize
-from rlcore.sweep import STOP_FILE, Sweep, run_sweep, start_ray
+from rlcore.sweep import STOP_FILE, Sweep
+from rlcore.sweep_ray import run_sweep, start_ray
 from tests.processes import alive, listening, outside_loopback, own_ray_processes
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -315,7 +315,7 @@ def test_a_trial_killed_before_its_first_checkpoint_starts_over_without_its_old_
     not kept under the new run's (they would repeat episode numbers and mix two runs' curves)."""
     import dataclasses
 
-    from rlcore.sweep import run_trial
+    from rlcore.sweep_trial import run_trial
     sweep = _sweep(tmp_path, "early", seeds=(0,))
     trial = tmp_path / "early" / "seed=0"
     trial.mkdir(parents=True)
@@ -395,7 +395,7 @@ def test_tune_warns_of_no_slow_report_even_when_imported_before_the_sweep(monkey
     threshold for "may be a performance bottleneck" lines: the threshold Tune derived then is set too."""
     from ray.tune.utils import util
 
-    from rlcore.sweep import quiet_tune
+    from rlcore.sweep_ray import quiet_tune
 
     monkeypatch.setattr(util.warn_if_slow, "DEFAULT_THRESHOLD", 0.5)  # as Tune reads it without the variable
     monkeypatch.setenv("TUNE_WARN_THRESHOLD_S", "")
@@ -425,7 +425,7 @@ def test_a_trial_trained_but_not_evaluated_is_evaluated_on_resume_and_never_left
     import dataclasses
 
     from rlcore.errors import UserError
-    from rlcore.sweep import run_trial
+    from rlcore.sweep_trial import run_trial
     sweep = _sweep(tmp_path, "late", seeds=(0,))
     Path(sweep.folder).mkdir()
     sweep.save()
