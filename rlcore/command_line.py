@@ -1,70 +1,18 @@
 """The command line (``deeprl``, or ``python main.py`` in a checkout): one subcommand per mode, and for `train` one flag per hyperparameter
-of the chosen experiment's preset. Every value is checked here, before any run folder exists; a bad
-command line is one line and exit status 2.
+of the chosen experiment's preset, a function per command below. Every value is checked here, before any
+run folder exists; a bad command line is one line and exit status 2 (the parser class: rlcore.cli_parser).
 
 TensorFlow-free, so `--help` is quick.
 """
 from __future__ import annotations
 
 import argparse
-import difflib
 import functools
 
 from rlcore import allowed
 from rlcore.allowed import Allowed, whole_number
+from rlcore.cli_parser import CommandParser, QuietParser, Unparsable
 from rlcore.seeding import MAX_EVAL_EPISODES, MAX_RUN_SEED
-
-
-# the names Stable-Baselines3, RL Zoo and CleanRL give these settings -> ours, each where a command has it
-# (--learning-rate is nearest --learning-starts by spelling, which is another setting)
-OTHER_NAMES = {"--learning-rate": ("--lr", "--actor-lr", "--critic-lr"), "--n-envs": ("--num-envs",), "--num-steps": ("--n-steps",),
-               "--total-timesteps": ("--steps",), "--n-timesteps": ("--steps",), "--n-epochs": ("--epochs",),
-               "--update-epochs": ("--epochs",), "--ent-coef": ("--entropy-coef",), "--vf-coef": ("--value-coef",),
-               "--clip-range": ("--clip",), "--clip-coef": ("--clip",), "--batch": ("--batch-size", "--minibatch"),
-               "--num-minibatches": ("--minibatch",), "--max-grad": ("--max-grad-norm",), "--env": ("EXPERIMENT",),
-               "--env-id": ("EXPERIMENT",), "--algo": ("ALGO",), "--net-arch": ("--hidden", "--actor-hidden", "--critic-hidden")}
-
-
-def _nearest(flag: str, options) -> list[str]:
-    """Ours for another library's name (``--learning-rate``: ``--lr``), else the one flag ``flag`` begins
-    (``--epi``: ``--episodes``), else the closest spelling (``--gama``), else none."""
-    ours = [name for name in OTHER_NAMES.get(flag, ()) if name in options or name.isupper()]
-    if ours:
-        return [f"the positional {name}" if name.isupper() else name for name in ours]
-    starting = [option for option in options if option.startswith(flag)]
-    return starting if len(starting) == 1 else difflib.get_close_matches(flag, list(options), n=1, cutoff=0.75)
-
-
-class _Parser(argparse.ArgumentParser):
-    """argparse that reports a bad command line as one line (and exit status 2), takes no abbreviated flag
-    (``--epi`` is not ``--episodes``), and answers a flag it does not know in the words of the command it was
-    given to, with the nearest flag that command has."""
-
-    def __init__(self, *args, **kwargs):
-        kwargs.setdefault("allow_abbrev", False)
-        super().__init__(*args, **kwargs)
-
-    def error(self, message):
-        hint = f"{self.prog} EXPERIMENT ALGO --help" if self.prog.endswith(" train") else f"{self.prog} --help"
-        self.exit(2, f"error: {message} (see `{hint}`)\n")
-
-    def parse_args(self, args=None, namespace=None):
-        known, unknown = self.parse_known_args(args, namespace)
-        if unknown:
-            command = self._command_parser(known)
-            flags = unknown[:unknown.index("--")] if "--" in unknown else unknown  # after --: not flags
-            near = [match for flag in flags if flag.startswith("--")
-                    for match in _nearest(flag.split("=")[0], command._option_string_actions) if match != flag]
-            command.error(f"unrecognized arguments: {' '.join(unknown)}"
-                          + (f"; did you mean {', '.join(near)}?" if near else ""))
-        return known
-
-    def _command_parser(self, known) -> argparse.ArgumentParser:
-        """The subcommand's parser (``main.py train``) a namespace was parsed by, else this one."""
-        for action in self._actions:
-            if isinstance(action, argparse._SubParsersAction):
-                return action.choices.get(getattr(known, action.dest, None), self)
-        return self
 
 
 def folder_name(text: str) -> str:
@@ -122,19 +70,33 @@ def _algorithms_by_experiment() -> str:
 
 
 def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentParser:
-    from rlcore.experiment import eval_episodes_words, experiment_names
+    """The whole command line; ``argv`` tells ``train`` which experiment's hyperparameters to add."""
+    from rlcore.experiment import eval_episodes_words
 
     episodes = eval_episodes_words()
     prog = prog or program_name()
-    parser = _Parser(
+    parser = CommandParser(
         prog=prog, description="TensorFlow 2 / Keras deep RL: train, evaluate, render and export agents.",
         epilog=EXAMPLES.format(prog=prog), formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="version", version=f"%(prog)s {package_version()}")
-    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND", parser_class=_Parser)
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND", parser_class=CommandParser)
 
     text = "experiments, algorithms, presets and shipped models with their scores"
     sub.add_parser("list", help=text, description=text[0].upper() + text[1:] + ", as the shipped models' "
                    "meta.json record them.")
+
+    _add_train(sub, prog, episodes, argv)
+    _add_evaluate_and_render(sub, episodes)
+    _add_export(sub)
+    _add_sweep(sub, episodes)
+    _add_report(sub)
+    _add_plot_status_and_docs(sub)
+    return parser
+
+
+def _add_train(sub, prog: str, episodes: str, argv: list[str]) -> None:
+    """``train``: the run's own options, then one flag per hyperparameter of the chosen preset."""
+    from rlcore.experiment import experiment_names
 
     train = sub.add_parser("train", help="train an agent (Ctrl-C or SIGTERM saves a checkpoint; --resume continues)",
                            description="Train an agent. Every hyperparameter of the chosen preset can be "
@@ -168,6 +130,11 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
     train.add_argument("--no-progress", action="store_true", help="no progress bar")
     _add_hyperparameters(train, argv)
 
+
+def _add_evaluate_and_render(sub, episodes: str) -> None:
+    """``evaluate`` (a saved model on unseen seeds, recorded or not) and ``render`` (a video of it)."""
+    from rlcore.experiment import experiment_names
+
     for name, text in (("evaluate", "greedy mean +- std of a saved model on unseen seeds "
                                     "(Mario: share of episodes reaching the flag, x position)"),
                        ("render", "an MP4 or GIF of a saved model playing (greedily; Mario samples from pi)")):
@@ -195,6 +162,12 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
             p.add_argument("--episodes", type=EVAL_EPISODES, default=None, help="default 1; Minitaur 3")
             p.add_argument("--seed", type=NON_NEGATIVE, default=None,
                            help="episode i uses seed SEED+i (default: the first evaluation seed)")
+
+
+def _add_export(sub) -> None:
+    """``export``: the acting network to SavedModel, TFLite or ONNX, checked against the Keras model."""
+    from rlcore.experiment import experiment_names
+
     export = sub.add_parser(
         "export", help="the acting network as a TF SavedModel, a TFLite (LiteRT) file or an ONNX file, "
                        "checked against the Keras model",
@@ -210,6 +183,12 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
                              "exports/EXPERIMENT_ALGO_FORMAT)")
     export.add_argument("--observations", type=whole_number(Allowed(low=1, high=100_000)), default=256,
                         help="observations the parity check feeds both networks (default 256)")
+
+
+def _add_sweep(sub, episodes: str) -> None:
+    """``sweep``: seeds x grid values on Ray Tune, each trial a run folder."""
+    from rlcore.experiment import experiment_names
+
     sweep = sub.add_parser(
         "sweep", help="many runs (seeds x grid values) on Ray Tune, locally or on a cluster",
         description="One trial per combination of --seeds and --grid values; each trial is an ordinary "
@@ -242,6 +221,10 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
     sweep.add_argument("--address", default=None,
                        help="join a running Ray cluster (e.g. 10.0.0.5:6379) instead of starting local Ray")
     sweep.add_argument("--resume", action="store_true", help="continue the sweep NAME; finished trials are kept")
+
+
+def _add_report(sub) -> None:
+    """``report``: sweeps' results over seeds, and keeping them in results/."""
     report = sub.add_parser("report", help="results of sweeps: per run, and mean / median / IQM with 95%% CIs",
                             description="Per run: the final evaluation on unseen seeds, env steps, wall time, "
                                         "and what its periodic evaluations saw (collapses, the weights kept). "
@@ -266,6 +249,9 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
                              "with a sweep.json written for them, each refused unless it followed one recipe "
                              "from random weights (no --init-from; its resumes changed budgets only)")
 
+
+def _add_plot_status_and_docs(sub) -> None:
+    """``plot`` and ``status`` (a run folder read back from its CSV tables), and ``docs``."""
     plot = sub.add_parser("plot", help="write the training plots of a run folder (running, interrupted "
                                        "or finished)",
                           description="Write the training plots of a run folder from its CSV tables: score "
@@ -300,7 +286,6 @@ def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentP
                           description="Rewrite every generated file and marked region (python -m rlcore.docgen).")
     docs.add_argument("--check", action="store_true",
                       help="write nothing; exit 1 listing every file that differs from what would be written")
-    return parser
 
 
 def _add_model_choice(p: argparse.ArgumentParser, experiments: list[str]) -> None:
@@ -341,15 +326,6 @@ def shipped_by_options() -> dict[str, tuple]:
     return options
 
 
-class _Unparsable(Exception):
-    pass
-
-
-class _QuietParser(argparse.ArgumentParser):
-    def error(self, message):
-        raise _Unparsable(message)
-
-
 def _add_hyperparameters(train: argparse.ArgumentParser, argv: list[str]) -> None:
     """Once EXPERIMENT and ALGO are on the command line, add one flag per hyperparameter.
 
@@ -367,7 +343,7 @@ def _add_hyperparameters(train: argparse.ArgumentParser, argv: list[str]) -> Non
             next(tokens, None)
         elif token not in ("-h", "--help"):
             line.append(token)
-    first = _QuietParser(add_help=False)
+    first = QuietParser(add_help=False)
     first.add_argument("experiment")
     first.add_argument("algo")
     first.add_argument("--preset")
@@ -379,7 +355,7 @@ def _add_hyperparameters(train: argparse.ArgumentParser, argv: list[str]) -> Non
                 first.add_argument(*action.option_strings, nargs=action.nargs, const=action.const)
     try:
         names, _ = first.parse_known_args(line)
-    except _Unparsable:
+    except Unparsable:
         return
     from rlcore.experiment import get_experiment
     from rlcore.hparams import add_arguments
