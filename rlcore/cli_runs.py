@@ -96,7 +96,8 @@ def cmd_sweep(args) -> int:
 
 def cmd_report(args) -> int:
     from rlcore.extras import require
-    from rlcore.report import KEPT_FILES, is_run_folder, keep, keep_runs, markdown, summarize
+    from rlcore.keeping import KEPT_FILES, is_run_folder, keep, keep_runs
+    from rlcore.report import markdown, summarize
     from rlcore.report_plots import plot_critic, plot_curves, plot_evals
 
     require("rliable.metrics", "The report command")  # the sweep extra, or one line saying so

@@ -1,6 +1,6 @@
 """The figures of ``main.py report``: learning curves (the 100-episode average of each run's training
 episodes) and periodic evaluations over env steps, each an IQM over runs with its 95 % stratified bootstrap
-band (:func:`rlcore.report.stratified_bootstrap_ci`), every run drawn thin beside it. TensorFlow-free."""
+band (:func:`rlcore.bootstrap.stratified_bootstrap_ci`), every run drawn thin beside it. TensorFlow-free."""
 from __future__ import annotations
 
 import csv
@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from rlcore.extras import require
-from rlcore.report import stratified_bootstrap_ci
+from rlcore.bootstrap import stratified_bootstrap_ci
 
 
 def run_curve(run_dir: Path) -> tuple[np.ndarray, np.ndarray]:

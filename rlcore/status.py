@@ -81,7 +81,7 @@ def resumes_lines(about: dict, most: int = 6) -> list[str]:
     follow one recipe shows that it did: none for a run never resumed; of many, the first and the
     ``most`` latest."""
     from rlcore.hparams import change_text
-    from rlcore.report import command_starts
+    from rlcore.run_commands import command_starts
 
     resumes = command_starts(about)[1:]
     if not resumes:

@@ -13,7 +13,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rlcore.report import aggregates, load_runs, probability_of_improvement, stratified_bootstrap_ci, summarize
+from rlcore.bootstrap import aggregates, probability_of_improvement, stratified_bootstrap_ci
+from rlcore.report import load_runs, summarize
 from rlcore.sweep import Sweep, parse_grid, parse_seeds
 from tests.test_cli import run
 from tests.processes import group_pids, listening, outside_loopback
@@ -408,7 +409,8 @@ def test_a_run_resumed_before_resumes_recorded_their_changes_is_not_kept():
     """Records from before 2026-11-27 list the commands but no command_starts: the resumes are there, what
     they changed is not, so the keep cannot show that they changed budgets only."""
     from rlcore.errors import UserError
-    from rlcore.report import check_one_recipe_throughout, command_starts
+    from rlcore.keeping import check_one_recipe_throughout
+    from rlcore.run_commands import command_starts
 
     old = {"commands": ["python main.py train mario_ppo ppo --seed 0", "python main.py train mario_ppo ppo --resume R"]}
     assert command_starts(old) == [None, None]

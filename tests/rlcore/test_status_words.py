@@ -30,7 +30,7 @@ def test_rollouts_of_a_task_without_a_success_event_give_no_success_share(tmp_pa
 
 
 def test_a_run_resumed_on_another_cpu_names_each_with_where_it_took_over():
-    from rlcore.report import cpus_text
+    from rlcore.run_commands import cpus_text
 
     epyc, xeon = "AMD EPYC (avx2 avx512_bf16)", "Intel Xeon (avx2 avx512f)"
     starts = [{"env_steps": 0, "cpu": epyc}, {"env_steps": 286_720, "cpu": epyc}, {"env_steps": 614_400, "cpu": xeon}]
