@@ -98,7 +98,7 @@ def cmd_report(args) -> int:
     from rlcore.extras import require
     from rlcore.keeping import KEPT_FILES, is_run_folder, keep, keep_runs
     from rlcore.report import markdown, summarize
-    from rlcore.report_plots import plot_critic, plot_curves, plot_evals
+    from rlcore.report_plots import SUCCESS_SHARE, plot_critic, plot_curves, plot_evals
 
     require("rliable.metrics", "The report command")  # the sweep extra, or one line saying so
     folders = [Path(d) for d in args.sweep_dirs]
@@ -124,10 +124,14 @@ def cmd_report(args) -> int:
     from rlcore.atomic import write_atomic
     out.mkdir(parents=True, exist_ok=True)  # after the summary: a sweep that cannot be read leaves no folder
     write_atomic(out / "report.md", lambda p: p.write_text(text + "\n"))
-    pngs = [plot_curves(result, out / "report_curves.png"), plot_evals(result, out / "report_evals.png"),
-            plot_critic(result, out / "report_critic.png")]
-    for name, png in (("report_evals.png", pngs[1]), ("report_critic.png", pngs[2])):
-        if png is None:  # nothing to draw now: an earlier report's figure would describe other runs
+    figures = {"report_curves.png": lambda path: plot_curves(result, path),
+               "report_success.png": lambda path: plot_curves(result, path, column=SUCCESS_SHARE),
+               "report_evals.png": lambda path: plot_evals(result, path),
+               "report_critic.png": lambda path: plot_critic(result, path)}
+    pngs = []
+    for name, draw in figures.items():
+        pngs.append(draw(out / name))
+        if pngs[-1] is None:  # nothing to draw now: an earlier report's figure would describe other runs
             (out / name).unlink(missing_ok=True)
     print(f"written: {out / 'report.md'}, {', '.join(str(p) for p in pngs if p)}")
     return 0

@@ -233,8 +233,9 @@ def _add_report(sub) -> None:
                                         "log a critic's Q (DQN family, SAC), each run's mean Q at its end beside "
                                         "its largest return. Writes report.md and report_curves.png into the "
                                         "sweep folder (several sweeps: into --out, else nothing is written), "
-                                        "with report_evals.png where runs evaluated periodically and "
-                                        "report_critic.png where they log Q.")
+                                        "with report_success.png where runs log a goal's successes (Mario's "
+                                        "flag: the share of the last 100 episodes), report_evals.png where "
+                                        "they evaluated periodically and report_critic.png where they log Q.")
     report.add_argument("sweep_dirs", nargs="+", metavar="SWEEP_DIR",
                         help="a sweep's folder (several: one report, compared); with --keep, finished run "
                              "folders of one recipe over seeds (main.py train ... --seed S) may be given instead")

@@ -22,6 +22,7 @@ import sys
 
 from rlcore.docgen_data import REPO, Model, shipped_models
 from rlcore.experiment import get_experiment, experiment_names
+from rlcore.score_words import success_word
 from rlcore.docgen_words import (OVER_SEEDS_HEADER, article_of, bar_met, bar_text, hours, link, model_page,
                                  over_seeds_cell, ret, score_text, sweep_score, table)
 
@@ -150,6 +151,10 @@ def region_curves(page: str, experiment: str) -> str:
         if m.sweep and (REPO / m.sweep.folder / "report_curves.png").is_file():
             parts.append(f"**{m.name}, {len(m.sweep.seeds)} seeds (IQM of the 100-episode average, 95% CI band)**"
                          f"\n\n![{m.name} sweep]({link(page, m.sweep.folder + '/report_curves.png')})")
+        if m.sweep and (REPO / m.sweep.folder / "report_success.png").is_file():
+            parts.append(f"**{m.name}, {len(m.sweep.seeds)} seeds: the share of the last 100 episodes that reached "
+                         f"the {success_word(experiment, m.name, 'goal')}, as the stop rule reads it (IQM, 95% CI band; each seed thin)**\n\n"
+                         f"![{m.name} sweep successes]({link(page, m.sweep.folder + '/report_success.png')})")
         if m.sweep and (REPO / m.sweep.folder / "report_evals.png").is_file():
             parts.append(f"**{m.name}, {len(m.sweep.seeds)} seeds: periodic evaluations on selection seeds (IQM, 95% CI "
                          f"band; each seed thin)**\n\n![{m.name} sweep evaluations]"

@@ -12,20 +12,32 @@ from rlcore.extras import require
 from rlcore.bootstrap import stratified_bootstrap_ci
 
 
-def run_curve(run_dir: Path) -> tuple[np.ndarray, np.ndarray]:
-    """One run's (env steps, 100-episode average return) at each episode's end, from metrics.csv."""
+#: metrics.csv's columns a report draws over env steps: the 100-episode average return, and for a task with a
+#: goal (Mario's flag) the share of the last 100 episodes from the start that reached it (the stop rule's)
+AVERAGE_RETURN, SUCCESS_SHARE = "av_latest_points", "success_share"
+
+
+def run_curve(run_dir: Path, column: str = AVERAGE_RETURN) -> tuple[np.ndarray, np.ndarray]:
+    """One run's (env steps, ``column``) at each episode's end, from metrics.csv (rows without a value
+    of it skipped)."""
     with open(Path(run_dir) / "metrics.csv", newline="") as f:
-        rows = list(csv.DictReader(f))
-    return (np.array([float(r["env_steps"]) for r in rows]),
-            np.array([float(r["av_latest_points"]) for r in rows]))
+        rows = [r for r in csv.DictReader(f) if r.get(column) not in (None, "")]
+    return (np.array([float(r["env_steps"]) for r in rows]), np.array([float(r[column]) for r in rows]))
 
 
-def learning_curve(run_dirs: list[Path], points: int = 40) -> tuple[np.ndarray, np.ndarray]:
-    """(env steps grid, [runs, points] 100-episode average return), each run interpolated.
+def has_column(run_dir: Path, column: str) -> bool:
+    """Whether a run's metrics.csv has ``column`` (SUCCESS_SHARE: the runs of a task with a goal)."""
+    with open(Path(run_dir) / "metrics.csv", newline="") as f:
+        return column in next(csv.reader(f), [])
+
+
+def learning_curve(run_dirs: list[Path], points: int = 40,
+                   column: str = AVERAGE_RETURN) -> tuple[np.ndarray, np.ndarray]:
+    """(env steps grid, [runs, points] of ``column``: the 100-episode average return), each run interpolated.
 
     The grid ends where the shortest run ends, so every point aggregates every run.
     """
-    curves = [run_curve(d) for d in run_dirs]
+    curves = [run_curve(d, column) for d in run_dirs]
     end = min(s[-1] for s, _ in curves)
     grid = np.linspace(0, end, points)
     return grid, np.stack([np.interp(grid, s, v) for s, v in curves])
@@ -68,20 +80,48 @@ def _figure():
     return plt.subplots(figsize=(8, 4.5))
 
 
-def plot_curves(result: dict, out: Path, reps: int = 1000) -> Path:
-    """IQM of the 100-episode average return over env steps, with its 95 % CI band, per sweep.
+def plot_curves(result: dict, out: Path, reps: int = 1000, column: str = AVERAGE_RETURN) -> Path | None:
+    """IQM of the 100-episode average return (or another of metrics.csv's ``column``) over env steps, with
+    its 95 % CI band, per sweep. ``None`` (no file) where no sweep's runs all log the column.
 
     The band covers the env steps every run reached; each run is also drawn in full, thin.
     """
+    sweeps = [s for s in result["sweeps"] if all(has_column(r["run_dir"], column) for r in s["runs"])]
+    if not sweeps:
+        return None
     fig, ax = _figure()
-    for s in result["sweeps"]:
-        grid, curves = learning_curve([r["run_dir"] for r in s["runs"]])
+    for s in sweeps:
+        grid, curves = learning_curve([r["run_dir"] for r in s["runs"]], column=column)
         iqm, low, high = _iqm_band(curves, reps)
         line, = ax.plot(grid, iqm, lw=2, label=f"{s['label']}: IQM of {len(s['runs'])} runs, 95% CI")
         ax.fill_between(grid, low, high, color=line.get_color(), alpha=0.25)
         for r in s["runs"]:  # each run in full, since runs with an episode budget end at different steps
-            ax.plot(*run_curve(r["run_dir"]), color=line.get_color(), lw=0.7, alpha=0.35)
+            ax.plot(*run_curve(r["run_dir"], column), color=line.get_color(), lw=0.7, alpha=0.35)
+    if column == SUCCESS_SHARE:
+        word, stop = _goal(sweeps)
+        if stop:  # where the runs' stop rule ends them
+            ax.axhline(stop, color="0.4", lw=0.8, ls="--", label=f"stop rule: {stop:.0%} of the last 100")
+        ax.set_ylim(-0.02, 1.02)
+        return _save_figure(fig, ax, f"share of the last 100 episodes\nthat reached the {word}", out)
     return _save_figure(fig, ax, "100-episode average return", out)
+
+
+def _goal(sweeps: list[dict]) -> tuple[str, float | None]:
+    """What the runs' successful episodes reach, as the cards say it (Mario: flag, or axe on x-4), and the
+    success share their stop rule ends them at (``--stop-success-share``), where all runs have the same."""
+    import json
+
+    from rlcore.score_words import success_word
+
+    words, stops = set(), set()
+    for s in sweeps:
+        for r in s["runs"]:
+            meta = json.loads((Path(r["run_dir"]) / "model" / "meta.json").read_text())
+            config = meta.get("config", {})
+            level = f"{config.get('world')}-{config.get('stage')}"
+            words.add(success_word(meta.get("experiment", ""), level, other="goal"))
+            stops.add(config.get("stop_success_share") or None)
+    return (words.pop() if len(words) == 1 else "goal"), (stops.pop() if len(stops) == 1 else None)
 
 
 def plot_evals(result: dict, out: Path, reps: int = 1000) -> Path | None:

@@ -198,7 +198,8 @@ def _mario_run(folder: Path, seed: int, flags: int, further: int | None = None, 
         meta["further_evaluations"] = [{"episodes": 30, "success_share": further / 30, "seeds": "1000010..1000039"}]
     (folder / "model" / "meta.json").write_text(json.dumps(meta))
     (folder / "model" / "actor.h5").write_bytes(b"weights")
-    (folder / "metrics.csv").write_text("episode,env_steps,av_latest_points\n1,10,1.0\n2,1000,%s\n" % flags)
+    (folder / "metrics.csv").write_text("episode,env_steps,av_latest_points,success,success_share\n"
+                                        "1,10,1.0,0,0.0\n2,1000,%s,1,0.5\n" % flags)
     (folder / "rollouts.csv").write_text("rollout,env_steps\n1,1000\n")
     (folder / "checkpoint.npz").write_bytes(b"large")
     return folder
@@ -218,7 +219,7 @@ def test_single_runs_over_seeds_are_kept_and_reported_as_a_sweep_of_their_level(
     code, out, err = run(capsys, "report", *runs, "--keep", str(kept), "--reps", "200")
     assert code == 0, err
     copied = sorted(str(p.relative_to(kept)) for p in kept.rglob("*") if p.is_file())
-    assert copied == sorted(["report.md", "report_curves.png", "sweep.json"]
+    assert copied == sorted(["report.md", "report_curves.png", "report_success.png", "sweep.json"]
                             + [f"seed={s}/{name}" for s in range(3)
                                for name in ("metrics.csv", "rollouts.csv", "model/meta.json", "model/actor.h5")])
     sweep = json.loads((kept / "sweep.json").read_text())
@@ -245,6 +246,26 @@ def test_single_runs_over_seeds_are_kept_and_reported_as_a_sweep_of_their_level(
     rows = docgen_sweeps.seed_runs("docs/x.md", "mario_ppo")
     assert "| 0 | flag in 9 of 10 | flag in 27 of 30 (1000010..1000039) | 1,000 | 10 s | 100 | – |" in rows
     assert "| 1 | flag in 10 of 10 | – |" in rows
+    monkeypatch.setattr(docgen, "shipped_models", lambda: [shipped])
+    monkeypatch.setattr(docgen, "REPO", tmp_path)
+    curves = docgen.region_curves("docs/experiments/mario_ppo.md", "mario_ppo")
+    assert ("1-1, 3 seeds: the share of the last 100 episodes that reached the flag, as the stop rule reads it"
+            in curves and "results/sweeps/mario_ppo__1-1/report_success.png)" in curves)
+
+
+def test_a_goal_tasks_report_draws_the_success_share_the_stop_rule_reads(tmp_path):
+    """Mario's seeds are scored by the flag: report_success.png draws metrics.csv's success_share (the share of
+    the last 100 episodes from the start, what --stop-success-share reads), with the runs' stop share; a level
+    x-4 ends at the axe."""
+    from rlcore.report_plots import SUCCESS_SHARE, _goal, run_curve
+
+    runs = [{"run_dir": _mario_run(tmp_path / f"run{s}", s, 8, stop_success_share=0.9)} for s in range(2)]
+    steps, shares = run_curve(runs[0]["run_dir"], SUCCESS_SHARE)
+    assert steps.tolist() == [10.0, 1000.0] and shares.tolist() == [0.0, 0.5]
+    assert _goal([{"runs": runs}]) == ("flag", 0.9)
+    castle = {"run_dir": _mario_run(tmp_path / "castle", 2, 8, stage=4, stop_success_share=0.8)}
+    assert _goal([{"runs": [castle]}]) == ("axe", 0.8)
+    assert _goal([{"runs": runs + [castle]}]) == ("goal", None)  # unlike runs: no one word, no one stop share
 
 
 def test_keeping_again_replaces_the_kept_folder_whole_and_never_another_folder(tmp_path, capsys):
