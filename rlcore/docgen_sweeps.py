@@ -11,6 +11,7 @@ from rlcore.critic_trace import WINDOW, critic_cell, critic_trace
 from rlcore.docgen_words import hours, link, num, over_seeds_bold, score_text, sweep_score, table
 from rlcore.eval_history import stability_summary, steps_text, story
 from rlcore.experiment import get_experiment
+from rlcore.run_commands import cpus_text
 
 #: what the sweep-stability region says before its tables (the rule is rlcore.eval_history's)
 STABILITY_INTRO = ("What the periodic evaluations (on selection seeds) saw through training: a *collapse* is an "
@@ -20,8 +21,8 @@ STABILITY_INTRO = ("What the periodic evaluations (on selection seeds) saw throu
                    "first to the task's solved score had little to lose, and none of its dips counts "
                    "(`rlcore/eval_history.py`).")
 SEED_RUNS_INTRO = ("Each seed's run: its score on unseen seeds (and further evaluations on other unseen seeds), env "
-                   "steps, wall time and speed on the machine that trained it (its CPU in the report), and what "
-                   "ended it.")
+                   "steps, wall time and speed on the CPU that trained it (each CPU a resume moved it to, from "
+                   "where it took over), and what ended it.")
 
 
 def _runs(folder: str, solved: float | None) -> list[tuple[dict, object]]:
@@ -156,11 +157,11 @@ def seed_runs(page: str, experiment: str) -> str:
                                 for f in meta.get("further_evaluations", [])) or "–"
             rows.append([str(meta["seed"]), evaluation_cell(ev, m), further, f"{meta['env_steps']:,}",
                          hours(meta["wall_seconds"]), f"{meta['env_steps'] / max(meta['wall_seconds'], 1e-9):,.0f}",
-                         stop_text(meta, m)])
+                         cpus_text(meta) or "not recorded", stop_text(meta, m)])
         parts.append(f"**[{m.name}]({link(page, m.sweep.folder + '/report.md')})**, beside the shipped model's "
                      f"{score_text(m)}:\n\n"
                      + table(["seed", "unseen seeds", "further unseen seeds", "env steps", "wall", "env steps/s",
-                              "stopped by"], rows, "rrrrrrl")
+                              "CPU", "stopped by"], rows, "rrrrrrll")
                      + f"\n\nOver the {len(runs)} seeds: {over_seeds_bold(m, '[95% CI] ')}." + seeds_bar_text(m))
     if not parts:
         return "*Not kept in `results/sweeps/` yet: the runs' table appears here when they are.*"

@@ -5,17 +5,18 @@ from __future__ import annotations
 
 
 def cpus_text(meta: dict) -> str | None:
-    """The CPUs a run trained on: meta.json's ``cpu`` (the last command's machine), or where its commands
-    recorded theirs (from 2026-11-29 on) and a resume moved the run to another CPU, each with where it
-    took over: ``AMD EPYC (...); Intel Xeon (...) from 614,400 env steps``."""
-    changes: list[tuple[int, str]] = []
-    for start in command_starts(meta):
-        cpu = (start or {}).get("cpu")
-        if cpu and (not changes or changes[-1][1] != cpu):
-            changes.append((int(start.get("env_steps", 0)), cpu))
-    if len(changes) < 2:
-        return meta.get("cpu") or (changes[0][1] if changes else None)
-    return "; ".join(cpu if i == 0 and steps == 0 else f"{cpu} from {steps:,} env steps"
+    """The CPUs a run trained on: where its commands recorded theirs (from 2026-11-29 on) and a resume moved
+    the run to another CPU, each with where it took over: ``AMD EPYC (...); Intel Xeon (...) from 614,400 env
+    steps``, and "not recorded" for the commands before the first that recorded one (a run begun with older
+    code); where none did, meta.json's ``cpu`` (the last command's machine)."""
+    cpus = [(int((start or {}).get("env_steps", 0)), (start or {}).get("cpu")) for start in command_starts(meta)]
+    if not any(cpu for _, cpu in cpus):
+        return meta.get("cpu")
+    changes: list[tuple[int, str | None]] = []
+    for steps, cpu in cpus:
+        if not changes or changes[-1][1] != cpu:
+            changes.append((steps, cpu))
+    return "; ".join((cpu or "not recorded") + ("" if i == 0 else f" from {steps:,} env steps")
                      for i, (steps, cpu) in enumerate(changes))
 
 

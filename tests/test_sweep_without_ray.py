@@ -244,7 +244,7 @@ def test_single_runs_over_seeds_are_kept_and_reported_as_a_sweep_of_their_level(
     assert "Bar over seeds: median over 3 seeds >= 80%, every seed >= 50% (" in summary and summary.endswith("): **met**.")
     assert "its runs made no periodic evaluations" in docgen_sweeps.sweep_stability("docs/x.md", "mario_ppo")
     rows = docgen_sweeps.seed_runs("docs/x.md", "mario_ppo")
-    assert "| 0 | flag in 9 of 10 | flag in 27 of 30 (1000010..1000039) | 1,000 | 10 s | 100 | – |" in rows
+    assert "| 0 | flag in 9 of 10 | flag in 27 of 30 (1000010..1000039) | 1,000 | 10 s | 100 | not recorded | – |" in rows
     assert "| 1 | flag in 10 of 10 | – |" in rows
     monkeypatch.setattr(docgen, "shipped_models", lambda: [shipped])
     monkeypatch.setattr(docgen, "REPO", tmp_path)

@@ -38,3 +38,7 @@ def test_a_run_resumed_on_another_cpu_names_each_with_where_it_took_over():
     assert cpus_text({"cpu": epyc, "command_starts": starts[:2]}) == epyc  # one CPU throughout
     assert cpus_text({"cpu": xeon, "command_starts": [None, {"env_steps": 9}]}) == xeon  # older records: meta's
     assert cpus_text({}) is None
+    # begun with code that recorded no CPU, resumed with code that does (Mario 1-1 seed 2): not passed off as
+    # one CPU throughout
+    mixed = [{"env_steps": 0}, {"env_steps": 614_400}, {"env_steps": 942_080, "cpu": xeon}]
+    assert cpus_text({"cpu": xeon, "command_starts": mixed}) == f"not recorded; {xeon} from 942,080 env steps"
