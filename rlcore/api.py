@@ -132,11 +132,30 @@ def model_folder(model: str | os.PathLike[str] | tuple[str, str]) -> Path:
         else:
             folder = shipping.models_root() / name / which
         return shipping.require_shipped(folder, f"{name} {which}")
+    if not isinstance(model, (str, os.PathLike)):
+        raise UserError(f"a model is a folder's path, a shipped model's (EXPERIMENT, ALGO or LEVEL) such as "
+                        f"('lunar_lander', 'dqn'), a Run or a Policy; got {model!r}")
     folder = Path(model)
     finished = folder / "model"
     if (finished / "meta.json").is_file() and not (folder / "meta.json").is_file():
         return finished
+    if not any((folder / name).is_file() for name in ("meta.json", "checkpoint.npz")):
+        if pair := _shipped_name(str(model)):  # "lunar_lander" or "lunar_lander/dqn" meant a shipped model
+            raise UserError(f"{model} is not a model folder; a shipped model is named as a pair: {pair}")
     return folder
+
+
+def _shipped_name(text: str) -> str | None:
+    """``('lunar_lander', 'dqn')`` for a text that names an experiment (``lunar_lander``, ``lunar_lander/dqn``,
+    ``mario_ppo/1-1``), written as the pair :func:`model_folder` takes; None for any other text."""
+    from rlcore.experiment import experiment_names, get_experiment
+
+    name, _, which = text.strip("/").partition("/")
+    if name not in experiment_names() or "/" in which:
+        return None
+    exp = get_experiment(name)
+    example = exp.shipped_by.default if exp.shipped_by else next(iter(exp.algos))
+    return f"({name!r}, {(which or example)!r})"
 
 
 @named_as_python

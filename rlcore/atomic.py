@@ -19,6 +19,8 @@ def writable_folder(folder: str | os.PathLike, what: str) -> Path:
     """Create ``folder`` (with its parents) and check that a file can be written in it, before any
     work whose result would go there; otherwise one clear error naming ``what`` (e.g. ``--out``)."""
     folder = Path(folder)
+    if folder.exists() and not folder.is_dir():
+        raise UserError(f"{what} {folder} is a file, not a folder")
     try:
         folder.mkdir(parents=True, exist_ok=True)
         with tempfile.TemporaryFile(dir=folder):

@@ -126,7 +126,7 @@ def cmd_render(args) -> int:
 
     name = _output_name(args)
     out = Path(args.out) if args.out else Path("videos") / f"{name}.mp4"
-    if out.is_dir():
+    if out.is_dir() or (args.out and (args.out.endswith("/") or not out.suffix)):  # a folder, made if new
         out = out / f"{name}.mp4"
     from rlcore.video import check_video_path
     out = check_video_path(out)  # .mp4 or .gif (by the suffix), else one line
@@ -142,14 +142,27 @@ def cmd_export(args) -> int:
 
     name = _output_name(args)
     out = Path(args.out) if args.out else Path("exports") / f"{name}_{args.format}"
+    earlier = _earlier_export(out)
     with _model(args) as (model_dir, source):
         record = export_model(model_dir, args.format, out, observations=args.observations, source=source,
                               experiment=args.experiment, algo=args.algo)
+    replaced = f"; it replaced the earlier {earlier} export there" if earlier else ""
     print(f"export:  {out / record['file']} ({record['format']}, runs on {record['runtime']['name']} "
-          f"{record['runtime']['version']})")
+          f"{record['runtime']['version']}{replaced})")
     print(f"parity:  {summary(record)} from seeds {record['parity']['seeds']}: passed")
     print(f"record:  {out / 'export.json'}")
     return 0
+
+
+def _earlier_export(out: Path) -> str | None:
+    """The format and model of the export ``out`` holds, which a new export there replaces whole."""
+    import json
+
+    try:
+        record = json.loads((out / "export.json").read_text())
+        return f"{record['format']} ({record['experiment']} {record['algo']})"
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
 
 
 def register_recorded_env(model: str | None) -> None:

@@ -15,7 +15,8 @@ def _run_folder(run_dir: Path) -> dict:
     from rlcore.status import run_record
 
     if not run_dir.is_dir():
-        raise UserError(f"{run_dir}: no such folder; give a run folder such as runs/<name>")
+        what = "is a file" if run_dir.exists() else "no such folder"
+        raise UserError(f"{run_dir}: {what}; give a run folder such as runs/<name>")
     if not (run_dir / "metrics.csv").is_file():
         raise UserError(f"no metrics.csv in {run_dir}; give a run folder such as runs/<name>")
     record = run_record(run_dir)

@@ -156,7 +156,7 @@ def _add_evaluate_and_render(sub, episodes: str) -> None:
         else:
             p.add_argument("--out", default=None,
                            help="an .mp4 or a .gif path (a GIF: ~320 px wide, every few frames, looping), "
-                                "or a folder for an MP4 (default videos/EXPERIMENT_ALGO.mp4)")
+                                "or a folder for an MP4, made if new (default videos/EXPERIMENT_ALGO.mp4)")
             p.add_argument("--fps", type=whole_number(FRAME_RATE), default=None,
                            help="frames per second (default: experiment's)")
             p.add_argument("--episodes", type=EVAL_EPISODES, default=None, help="default 1; Minitaur 3")
@@ -177,7 +177,9 @@ def _add_export(sub) -> None:
                     "experiment's env on evaluation seeds. OUT gets the file and export.json; a failed "
                     "check is one line, exit status 2, and OUT is left as it was. See docs/export.md.")
     _add_model_choice(export, experiment_names())
-    export.add_argument("--format", required=True, choices=["savedmodel", "tflite", "onnx"])
+    export.add_argument("--format", required=True, choices=["savedmodel", "tflite", "onnx"],
+                        help="savedmodel: a TF SavedModel folder (tf.saved_model.load, TF Serving); tflite: a .tflite "
+                             "file for LiteRT; onnx: an .onnx file for onnxruntime (needs the export extra)")
     export.add_argument("--out", default=None, metavar="OUT",
                         help="the export folder, new or an earlier export (default "
                              "exports/EXPERIMENT_ALGO_FORMAT)")
@@ -195,7 +197,8 @@ def _add_sweep(sub, episodes: str) -> None:
                     "run folder under DIR/NAME/ (evaluate, render and plot work on it). A trial "
                     "restarted after a crash resumes from its checkpoint; Ctrl-C or SIGTERM stops every trial "
                     "at a checkpoint; --resume continues and skips finished trials.")
-    sweep.add_argument("experiment", help=f"one of {', '.join(experiment_names())}")
+    sweep.add_argument("experiment", help=f"one of {', '.join(experiment_names())}, or any registered Gymnasium "
+                                          "id whose spaces fit ALGO (as train takes)")
     sweep.add_argument("algo", help="an algorithm of the experiment (`list` shows them)")
     sweep.add_argument("--seeds", default="0-4", help="a range or a list: 0-4, 0,3,7 (default 0-4)")
     sweep.add_argument("--grid", action="append", default=[], metavar="NAME=V1,V2",

@@ -19,6 +19,21 @@ FILE_ROLES = {".h5": "Keras model (the whole network, loadable on its own)", "me
               "metrics.csv": "one row per training episode", "evals.csv": "the periodic evaluations on selection seeds",
               "rollouts.csv": "one row per PPO rollout (losses, entropy, KL, learning rate)",
               ".png": "training plot", "HOW_TRAINED.md": "the training log, in words", "README.md": "this card"}
+# a plot's kind, as rlcore/plotting.py names its file (PREFIX_KIND_ALGO.png), and what it draws
+PLOT_ROLES = {"Train": "training plot: each episode's return and the 100-episode average",
+              "Eval": "the periodic evaluations on selection seeds over training",
+              "Progress": "training plot: how far episodes got (x position) and the share reaching the goal",
+              "Endings": "training plot: where episodes ended along the level",
+              "Deaths": "training plot: what ended the failed episodes, share by cause"}
+
+
+def file_role(name: str) -> str:
+    """What a model folder's file is, for the card's Files table."""
+    if name.endswith(".png"):
+        kind = next((kind for kind in PLOT_ROLES if f"_{kind}_" in name), None)
+        if kind:
+            return PLOT_ROLES[kind]
+    return FILE_ROLES.get(name) or FILE_ROLES.get("." + name.rsplit(".", 1)[-1], "")
 
 
 # ---------------------------------------------------------------------------------- front matter
@@ -195,7 +210,7 @@ def files_section(m: Model, page: str, docs: bool) -> str:
     for path in sorted((REPO / m.folder).iterdir()):
         if path.is_dir() or path.name == "README.md":
             continue
-        role = FILE_ROLES.get(path.name) or FILE_ROLES.get(path.suffix, "")
+        role = file_role(path.name)
         size = path.stat().st_size
         # the docs site serves the plots, logs and meta.json (rlcore/docgen_hooks.py), not the CSVs or models
         served = not docs or path.suffix == ".png" or path.name in ("HOW_TRAINED.md", "meta.json")

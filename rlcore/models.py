@@ -31,7 +31,8 @@ def load_keras_model(path: str | os.PathLike, obs_shape: int | tuple | None = No
     """
     path = Path(path)
     if not path.is_file():
-        raise UserError(f"model file {path} does not exist; train one first or pass --model")
+        raise UserError(f"model file {path} does not exist: a model folder holds its .h5 files beside "
+                        f"meta.json, as training writes them")
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")

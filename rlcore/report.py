@@ -16,6 +16,7 @@ from rlcore.bootstrap import AGGREGATES, aggregates, probability_of_improvement,
 from rlcore.errors import UserError
 from rlcore.eval_history import stability_summary, story, story_text
 from rlcore.run_commands import cpus_text
+from rlcore.score_words import count
 
 
 def load_runs(sweep_dir: Path) -> list[dict]:
@@ -111,7 +112,7 @@ def markdown(result: dict) -> str:
         lines += [f"| {r['trial']} | {r['seed']} | {r['score']:.3f} | {share_text(r.get('time_limit_share'))} "
                   f"| {r['env_steps']:,} | {r['wall_seconds']:.0f} s | {r['env_steps'] / max(r['wall_seconds'], 1e-9):,.0f} "
                   f"| {r.get('cpu') or 'not recorded'} |" for r in s["runs"]]
-        lines += ["", f"| over {len(s['runs'])} runs | point | 95% CI (stratified bootstrap) |",
+        lines += ["", f"| over {count(len(s['runs']), 'run')} | point | 95% CI (stratified bootstrap) |",
                   "| --- | ---: | --- |"]
         lines += [f"| {name} | {p:.3f} | [{lo:.3f}, {hi:.3f}] |" for name, (p, lo, hi) in s["aggregates"].items()]
         if any(r.get("further") for r in s["runs"]):

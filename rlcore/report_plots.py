@@ -10,6 +10,7 @@ import numpy as np
 
 from rlcore.extras import require
 from rlcore.bootstrap import stratified_bootstrap_ci
+from rlcore.score_words import count
 
 
 #: metrics.csv's columns a report draws over env steps: the 100-episode average return, and for a task with a
@@ -93,7 +94,7 @@ def plot_curves(result: dict, out: Path, reps: int = 1000, column: str = AVERAGE
     for s in sweeps:
         grid, curves = learning_curve([r["run_dir"] for r in s["runs"]], column=column)
         iqm, low, high = _iqm_band(curves, reps)
-        line, = ax.plot(grid, iqm, lw=2, label=f"{s['label']}: IQM of {len(s['runs'])} runs, 95% CI")
+        line, = ax.plot(grid, iqm, lw=2, label=f"{s['label']}: IQM of {count(len(s['runs']), 'run')}, 95% CI")
         ax.fill_between(grid, low, high, color=line.get_color(), alpha=0.25)
         for r in s["runs"]:  # each run in full, since runs with an episode budget end at different steps
             ax.plot(*run_curve(r["run_dir"], column), color=line.get_color(), lw=0.7, alpha=0.35)
@@ -145,7 +146,7 @@ def plot_evals(result: dict, out: Path, reps: int = 1000) -> Path | None:
         if steps:
             curves = np.array([[next(e.mean for e in evals if e.env_steps == x) for x in steps] for evals in runs])
             iqm, low, high = _iqm_band(curves, reps)
-            line, = ax.plot(steps, iqm, lw=2, label=f"{s['label']}: IQM of {len(runs)} runs, 95% CI")
+            line, = ax.plot(steps, iqm, lw=2, label=f"{s['label']}: IQM of {count(len(runs), 'run')}, 95% CI")
             ax.fill_between(steps, low, high, color=line.get_color(), alpha=0.25)
         for evals in runs:
             ax.plot([e.env_steps for e in evals], [e.mean for e in evals], lw=0.7, alpha=0.45,

@@ -33,6 +33,9 @@ def build_spec(experiment: str, algo: str, *, preset: str | None = None, seed: i
     something left to train unless ``nothing_to_train_ok`` (``--publish``: evaluate it again, publish).
     ``wandb_mode`` and ``final_eval_episodes`` left None: ``auto`` and the experiment's default for a new
     run, the run's own for a resume (its checkpoint records them)."""
+    from rlcore.run_lock import refuse_if_busy
+
+    refuse_if_busy(run_dir)  # before the checkpoint is read or a header printed
     exp = get_experiment(experiment)
     overrides = dict(overrides or {})
     extra = {} if command is None else {"command": command}
@@ -151,10 +154,25 @@ def check_new_run_dir(run_dir: Path) -> None:
     overwrite its checkpoint."""
     from rlcore.trainers.spec import CHECKPOINT_FILE
 
+    if Path(run_dir).exists() and not Path(run_dir).is_dir():
+        raise UserError(f"{setting('run_dir', str(run_dir))} is a file, not a folder")
     held = [name for name in (CHECKPOINT_FILE, "metrics.csv") if (Path(run_dir) / name).is_file()]
     if held:
         raise UserError(f"{setting('run_dir', str(run_dir))} already holds a run ({held[0]}); continue it with "
                         f"{resume_words(run_dir)}, or give another {flag('run_dir')}")
+
+
+def untrained_note(config) -> str | None:
+    """A note where the env-step budget ends an off-policy run (DQN, SAC) before its first gradient step:
+    its model would be the untrained network (a short --steps with the default --learning-starts)."""
+    starts, budget = getattr(config, "learning_starts", None), getattr(config, "max_env_steps", 0)
+    if starts is None or not budget:
+        return None
+    first = max(starts, getattr(config, "batch_size", 0))
+    if budget > first:
+        return None
+    return (f"note: {setting('max_env_steps', budget)} is no more than the {first:,} env steps the run collects "
+            f"before its first update ({flag('learning_starts')} {starts:,}): it will learn little or nothing")
 
 
 def train_and_evaluate(spec: RunSpec, on_progress: Callable[[dict, str], None] | None = None,
@@ -166,6 +184,8 @@ def train_and_evaluate(spec: RunSpec, on_progress: Callable[[dict, str], None] |
 
     from rlcore import shipping
 
+    if note := untrained_note(spec.config):
+        say(note)
     model_dir = run_training(spec, on_progress)
     meta = json.loads((model_dir / "meta.json").read_text())
     say(f"trained: {meta['episodes']} episodes, {meta['env_steps']} env steps, "

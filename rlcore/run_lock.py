@@ -50,9 +50,39 @@ def hold_run_folder(run_dir: str | os.PathLike) -> Iterator[Path]:
         os.close(fd)  # closing the descriptor releases the lock
 
 
+def refuse_if_busy(run_dir: str | os.PathLike) -> None:
+    """Refuse at once a run folder that another process writes, before a command loads or prints anything
+    (a resume read the checkpoint and printed its header first, and was refused ~40 s later). The lock is
+    taken for real when training starts (:func:`hold_run_folder`), so a writer that begins in between is
+    still refused there."""
+    folder = Path(run_dir).resolve()
+    if folder in _held:  # this process holds it (a sweep's trial): a second descriptor would contend with it
+        return
+    try:
+        fd = os.open(folder / LOCK_FILE, os.O_RDWR)
+    except OSError:  # no lock file: nobody has written there, or it cannot be opened (the real lock says why)
+        return
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        fcntl.flock(fd, fcntl.LOCK_UN)
+    except OSError as exc:
+        if exc.errno in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
+            raise _busy(folder, os.pread(fd, 32, 0)) from None
+    finally:
+        os.close(fd)
+
+
+def _busy(folder: Path, holder: bytes) -> RunFolderBusy:
+    pid = holder.decode(errors="replace").strip() or "unknown"
+    return RunFolderBusy(f"run folder {folder} is being written by process {pid}; wait for it to end "
+                         f"(or stop it: kill {pid}), then resume it")
+
+
 def _lock(folder: Path) -> int:
     """Create the folder if needed and lock its lock file; the descriptor. A lock file removed while we
     waited for it (its folder was dropped by a run that failed before writing) is locked again anew."""
+    if folder.exists() and not folder.is_dir():
+        raise UserError(f"run folder {folder} is a file, not a folder")
     for _ in range(5):
         try:
             folder.mkdir(parents=True, exist_ok=True)
@@ -62,12 +92,11 @@ def _lock(folder: Path) -> int:
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError as exc:
-            holder = os.pread(fd, 32, 0).decode(errors="replace").strip() or "unknown"
+            holder = os.pread(fd, 32, 0)
             os.close(fd)
             if exc.errno not in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
                 raise UserError(f"run folder {folder}: cannot lock it ({exc.strerror})") from None
-            raise RunFolderBusy(f"run folder {folder} is being written by process {holder}; wait for it to end "
-                                f"(or stop it: kill {holder}), then resume it") from None
+            raise _busy(folder, holder) from None
         if _still_there(fd, folder / LOCK_FILE):
             return fd
         os.close(fd)  # we locked a file that is gone from the folder: another process may lock the new one

@@ -27,6 +27,11 @@ def return_digits(mean: float) -> int:
     return 1 if abs(mean) >= 100 else 2
 
 
+def count(number: int, noun: str) -> str:
+    """``1 episode``, ``30 episodes``, ``1,000 runs``: a count with its noun, singular for one."""
+    return f"{number:,} {noun}" + ("" if number == 1 else "s")
+
+
 def hours(seconds: float) -> str:
     """A wall time as the tables write it: ``3.1 h`` from an hour up, else ``725 s``."""
     return f"{seconds / 3600:.1f} h" if seconds >= 3600 else f"{seconds:,.0f} s"

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from rlcore.errors import UserError
-from rlcore.score_words import return_digits, score_words, success_word
+from rlcore.score_words import count, return_digits, score_words, success_word
 
 #: the saved_networks/ of the checkout this package runs from (``python main.py`` or an editable install)
 SAVED_NETWORKS = Path(__file__).resolve().parents[1] / "saved_networks"
@@ -124,11 +124,16 @@ def run_evaluation(exp, policy, episodes: int, seed_base: int | None, meta: dict
     full = sum(r["time_limit"] for r in records)
     summary = {"episodes": episodes, "mean": round(float(returns.mean()), 2),
                "std": round(float(returns.std()), 2), "min": round(float(returns.min()), 2),
+               "max": round(float(returns.max()), 2),
                "time_limit_share": round(full / episodes, 3), "seeds": seeds, "policy": "greedy",
                "per_episode": records}
     digits = return_digits(summary["mean"])  # as score_words, the README and `list` write the recorded one
-    line = (f"greedy return {score_words(summary, exp.name, '', '+-')} over {len(returns)} episodes "
-            f"(min {returns.min():.{digits}f}, max {returns.max():.{digits}f}); {full}/{episodes} lasted to "
+    # SAC acts by its mean action, the others by their greedy action
+    from rlcore.policies import MeanActionPolicy
+
+    acting = "mean-action" if isinstance(policy, MeanActionPolicy) else "greedy"
+    line = (f"{acting} return {score_words(summary, exp.name, '', '+-')} over {count(len(returns), 'episode')} "
+            f"(min {returns.min():,.{digits}f}, max {returns.max():,.{digits}f}); {full}/{episodes} lasted to "
             f"the time limit")
     for key in exp.info_keys:
         values = [r[key] for r in records if key in r]
@@ -143,16 +148,23 @@ def run_evaluation(exp, policy, episodes: int, seed_base: int | None, meta: dict
 def _bar_words(exp, meta: dict | None, summary: dict, seed_base: int) -> str:
     """``; the shipped model's bar (mean return >= 230): met``, for a model of an algorithm or level that
     ships one with a bar (the task's solved score is another number: LunarLander's 200, Minitaur's 15).
-    The bar is judged on the experiment's evaluation (its episode count, on its unseen seeds): fewer
-    episodes, or seeds outside that range, say so beside the verdict."""
+    The bar is judged on the experiment's evaluation (its episode count, on seeds no part of training
+    met): fewer episodes, seeds in training's range, or the seeds of the periodic evaluations that chose
+    the model's weights, say so beside the verdict. Seeds past those are as unseen as the unseen range."""
     bar = exp.bar(model_name(exp, meta) or str(meta.get("algo", ""))) if meta else None
     if bar is None:
         return ""
     caveats = []
     if summary["episodes"] < exp.eval_episodes:
-        caveats.append(f"on {summary['episodes']} episodes, where it is judged on {exp.eval_episodes}")
-    if not exp.eval_seed_base <= seed_base < exp.selection_seed_base:
-        caveats.append("on seeds outside the unseen range, which training may have met")
+        caveats.append(f"on {count(summary['episodes'], 'episode')}, where it is judged on {exp.eval_episodes}")
+    seeds = range(seed_base, seed_base + summary["episodes"])
+    config = meta.get("config") or {}
+    periodic = range(exp.selection_seed_base,
+                     exp.selection_seed_base + (int(config.get("eval_episodes") or 0) if config.get("eval_every_steps") else 0))
+    if seeds.start < exp.eval_seed_base:
+        caveats.append("on seeds in training's range, which training may have met")
+    elif seeds.start < periodic.stop and periodic.start < seeds.stop:
+        caveats.append("on the seeds of the periodic evaluations that chose the model's weights")
     verdict = "met" if bar.met_by(summary) else "not met"
     return f"; the shipped model's bar ({bar.describe()}): {verdict}" + (f" ({'; '.join(caveats)})" if caveats else "")
 

@@ -13,6 +13,7 @@ TensorFlow-free until a trial trains.
 from __future__ import annotations
 
 import json
+import math
 import os
 import time
 from pathlib import Path
@@ -102,8 +103,10 @@ def _train_trial(trial: dict, sweep: Sweep, run_dir: Path, report) -> dict:
         now = time.monotonic()
         if table != "metrics" or now - last[0] >= 1.0:  # episodes at most once a second
             last[0] = now
+            # finite numbers only: a loss logged as NaN before the first update made Tune's TensorBoard
+            # logger print "NaN or Inf found in input tensor." in the sweep's console
             report({f"{table}/{k}" if table != "metrics" else k: v for k, v in row.items()
-                    if isinstance(v, (int, float)) and not isinstance(v, bool)})
+                    if isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)})
     try:
         model_dir = run_training(spec, on_progress)
     except Interrupted:

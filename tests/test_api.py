@@ -27,6 +27,8 @@ def test_shipped_model_by_name_predicts_and_evaluates():
     recorded = policy.meta["evaluation"]["per_episode"][:2]  # the same seeds the shipped evaluation played
     assert [r["seed"] for r in result["per_episode"]] == [r["seed"] for r in recorded]
     assert result["episodes"] == 2 and result["line"].startswith("greedy return")
+    returns = [r["return"] for r in result["per_episode"]]
+    assert (result["min"], result["max"]) == (round(min(returns), 2), round(max(returns), 2))  # as the line
 
 
 def test_mario_level_by_name():
@@ -41,9 +43,14 @@ def test_mario_level_by_name():
     (("moon_lander", "dqn"), "unknown experiment 'moon_lander'"),
     (("mario_ppo", "8-4"), "no shipped model mario_ppo 8-4"),
     ("/nonexistent/model", "/nonexistent/model: no such model folder"),
+    # a shipped model's name written as a path: the pair it meant
+    ("lunar_lander/dqn", r"^lunar_lander/dqn is not a model folder; a shipped model is named as a pair: "
+                         r"\('lunar_lander', 'dqn'\)$"),
+    ("mario_ppo", r"a shipped model is named as a pair: \('mario_ppo', '1-1'\)$"),
+    (5, r"^a model is a folder's path, a shipped model's \(EXPERIMENT, ALGO or LEVEL\) .*; got 5$"),
 ])
 def test_load_mistakes_are_user_errors(model, message):
-    if model[0] == "mario_ppo":
+    if isinstance(model, tuple) and model[0] == "mario_ppo":
         pytest.importorskip("nes_py", reason="the mario extra is not installed")
     with pytest.raises(UserError, match=message):
         api.load(model)

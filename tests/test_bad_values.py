@@ -135,8 +135,34 @@ def test_an_unwritable_output_place_is_one_line_exit_2(capsys, tmp_path, argv, w
     argv = [a.replace("BLOCK", str(block)).replace("RUN", str(run_dir)) for a in argv]
     code, out, err = run(capsys, *argv)
     assert code == 2, (out, err)
-    assert f"{what} {block}" in err and "cannot write there" in err, err
+    # "BLOCK/x: cannot write there (Not a directory)", or where the folder asked for is BLOCK itself (render's
+    # --out BLOCK/demo.mp4): "BLOCK is a file, not a folder"
+    assert f"{what} {block}" in err and ("cannot write there" in err or f"{block} is a file, not a folder" in err), err
     assert len(err.strip().splitlines()) == 1 and block.read_text() == "a file, not a folder"
+
+
+IS_A_FILE = [  # BLOCK itself is a file where a folder is asked for: said so, before anything is printed
+    (["train", "cartpole", "dqn", "--episodes", "1", "--wandb", "off", "--run-dir", "BLOCK"],
+     "--run-dir BLOCK is a file, not a folder"),
+    (["plot", "RUN", "--out", "BLOCK"], "--out BLOCK is a file, not a folder"),
+    (["status", "BLOCK"], "BLOCK: is a file; give a run folder such as runs/<name>"),
+]
+
+
+@pytest.mark.parametrize("argv, message", IS_A_FILE)
+def test_a_file_where_a_folder_is_asked_for_is_named_as_one(capsys, tmp_path, argv, message):
+    block = tmp_path / "block"
+    block.write_text("a file, not a folder")
+    run_dir = tmp_path / "run"
+    run_dir.mkdir()
+    (run_dir / "metrics.csv").write_text("episode,total_points\n1,2.0\n")
+    (run_dir / "model").mkdir()
+    (run_dir / "model" / "meta.json").write_text('{"experiment": "toy", "algo": "dqn"}')
+    argv = [a.replace("BLOCK", str(block)).replace("RUN", str(run_dir)) for a in argv]
+    code, out, err = run(capsys, *argv)
+    assert code == 2 and out == "", (out, err)
+    assert err.strip() == "error: " + message.replace("BLOCK", str(block)), err
+    assert block.read_text() == "a file, not a folder"
 
 
 def test_render_wants_an_mp4_or_gif_name_or_a_folder(capsys, tmp_path):
@@ -254,8 +280,9 @@ def test_list_and_help_print_no_tensorflow_line(argv, tmp_path):
 
 
 def test_rendering_a_pygame_env_and_a_tflite_export_print_only_our_lines(tmp_path):
-    code, text = _cli("render", "cartpole", "a2c", "--episodes", "1", "--out", str(tmp_path / "c.mp4"), cwd=tmp_path)
-    assert code == 0 and "video:" in text
+    # --out a folder that is not there yet (its trailing '/' says it is one): made, the video named in it
+    code, text = _cli("render", "cartpole", "a2c", "--episodes", "1", "--out", f"{tmp_path / 'vids'}/", cwd=tmp_path)
+    assert code == 0 and "video:" in text and (tmp_path / "vids" / "cartpole_a2c.mp4").is_file(), text
     pytest.importorskip("ai_edge_litert", reason="the export extra is not installed")
     code2, text2 = _cli("export", "cartpole", "a2c", "--format", "tflite", "--out", str(tmp_path / "x"), cwd=tmp_path)
     assert code2 == 0 and "parity:" in text2
@@ -267,7 +294,7 @@ def test_training_and_minitaur_evaluation_print_only_our_lines(tmp_path):
                       "--final-eval-episodes", "0", "--run-dir", str(tmp_path / "run"), cwd=tmp_path)
     assert code == 0 and "trained: 2 episodes" in text
     code2, text2 = _cli("evaluate", "minitaur", "sac", "--episodes", "1", cwd=tmp_path)
-    assert code2 == 0 and "greedy return" in text2
+    assert code2 == 0 and "mean-action return" in text2  # SAC acts by its mean action, not greedily
     assert not [word for word in NOISE if word in text + text2], text + text2
 
 

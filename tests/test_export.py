@@ -100,6 +100,11 @@ def test_a_failed_parity_check_is_one_line_and_keeps_the_earlier_export(monkeypa
     assert err.startswith("error: savedmodel export of") and "\n" not in err
     assert (out / "export.json").read_text() == before  # the earlier export, untouched
     assert sorted(p.name for p in tmp_path.iterdir()) == ["lander"]
+    monkeypatch.undo()
+    # an export that passes replaces the folder whole, and says what it replaced
+    assert main.main(["export", "lunar_lander", "dqn", "--format", "savedmodel", "--out", str(out),
+                      "--observations", "32"]) == 0
+    assert "it replaced the earlier savedmodel (lunar_lander dqn) export there" in capsys.readouterr().out
 
 
 def test_export_of_a_missing_model_folder_is_one_line(tmp_path, capsys):

@@ -36,8 +36,9 @@ def test_a_second_writer_is_refused_and_a_killed_holder_leaves_no_stale_lock(tmp
     holder = hold_elsewhere(run_dir)
     before = fingerprint(run_dir)
     try:
-        code, _, err = run(capfd, "train", "cartpole", "dqn", "--resume", str(run_dir), "--episodes", "4", *QUICK)
+        code, out, err = run(capfd, "train", "cartpole", "dqn", "--resume", str(run_dir), "--episodes", "4", *QUICK)
         assert code == 2
+        assert out == "", out  # refused before the checkpoint is read: no "resuming ..." or "training ..." line first
         lines = err.strip().splitlines()
         assert len(lines) == 1 and str(run_dir.resolve()) in lines[0] and str(holder.pid) in lines[0], lines
         assert fingerprint(run_dir) == before  # nothing written, nothing dropped

@@ -4,6 +4,7 @@ folder, a trial killed before its first checkpoint, and SIGTERM to a command-lin
 group (that sweep starts its own local Ray). Apart from tests/test_sweep.py so that `make test` can run
 them on another worker beside the Ray trials."""
 import json
+import math
 import os
 import signal
 import subprocess
@@ -343,7 +344,11 @@ def test_a_trial_killed_before_its_first_checkpoint_starts_over_without_its_old_
     trial.mkdir(parents=True)
     header = "episode,total_points,av_latest_points,target_ave_scores,env_steps,wall_seconds\n"
     (trial / "metrics.csv").write_text(header + "1,-12345.0,-12345.0,,7,0.1\n2,-12345.0,-12345.0,,9,0.2\n")
-    run_trial({"seed": 0}, dataclasses.asdict(sweep), {"toy": "tests.toy"}, lambda metrics: None)
+    reported = []
+    run_trial({"seed": 0}, dataclasses.asdict(sweep), {"toy": "tests.toy"}, reported.append)
+    # Tune gets finite numbers only (a NaN loss before the first update printed a TensorBoard warning)
+    assert "nan" in (trial / "metrics.csv").read_text()
+    assert reported and all(math.isfinite(v) for metrics in reported for v in metrics.values())
     rows = (trial / "metrics.csv").read_text().splitlines()[1:]
     episodes = [int(line.split(",")[0]) for line in rows]
     assert episodes == list(range(1, len(episodes) + 1)) and len(episodes) >= 2

@@ -59,7 +59,9 @@ class EpisodeBook:
         if (self.solved_score is not None and self.solved_episode is None and self.full_window()
                 and self.average >= self.solved_score):
             self.solved_episode = self.episodes
-            tqdm.write(f"\nEnvironment solved in {self.episodes} episodes!")
+            # the article's line; the run goes on, since its own stop rules and budget end it
+            tqdm.write(f"\nEnvironment solved in {self.episodes} episodes! (the last {self.window} average "
+                       f"{self.average:.1f} >= {self.solved_score:g}; training goes on until a stop rule or its budget ends it)")
         if self.episodes % self.window == 0:
             which = "episodes" if len(self.counted_returns) == self.episodes else "full episodes"
             tqdm.write(f"Episode {self.episodes} | Total point average of the last {self.window} "
