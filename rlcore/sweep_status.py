@@ -8,7 +8,8 @@ from pathlib import Path
 
 from rlcore.critic_trace import critic_cell, critic_trace
 from rlcore.errors import UserError
-from rlcore.status import NO_BUDGET, evaluation_lines, pace, pace_text, run_record
+from rlcore.run_pace import NO_BUDGET, pace, pace_text
+from rlcore.status import evaluation_lines, run_record
 
 NOT_STARTED = "not started"
 

@@ -78,7 +78,7 @@ def test_status_of_a_run_resumed_many_times_names_the_first_and_latest_resumes()
 
 
 def test_pace_reads_only_the_rows_since_a_counter_went_back_and_never_says_nan(tmp_path):
-    from rlcore.status import pace
+    from rlcore.run_pace import pace
 
     about = {"env_steps": 3000, "config": {"max_env_steps": 6000}}
     table = tmp_path / "metrics.csv"
@@ -92,7 +92,7 @@ def test_pace_reads_only_the_rows_since_a_counter_went_back_and_never_says_nan(t
 
 
 def test_the_hours_left_are_read_from_the_pace_of_learning_not_of_the_random_first_steps(tmp_path):
-    from rlcore.status import pace
+    from rlcore.run_pace import pace
 
     about = {"env_steps": 4000, "config": {"max_env_steps": 10_000}}
     table = tmp_path / "metrics.csv"

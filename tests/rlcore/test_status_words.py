@@ -42,3 +42,17 @@ def test_a_run_resumed_on_another_cpu_names_each_with_where_it_took_over():
     # one CPU throughout
     mixed = [{"env_steps": 0}, {"env_steps": 614_400}, {"env_steps": 942_080, "cpu": xeon}]
     assert cpus_text({"cpu": xeon, "command_starts": mixed}) == f"not recorded; {xeon} from 942,080 env steps"
+
+
+def test_the_hours_left_to_a_budget_say_a_stop_rule_may_end_the_run_sooner():
+    """Mario 1-1's seeds run to a 0.9 flag share, under a 6M-step budget they never reach: the hours to that
+    budget are an upper bound, and the line says so."""
+    from pathlib import Path
+
+    from rlcore.run_pace import pace_text
+
+    measured = (53.0, 25.5 * 3600)
+    text = pace_text(Path("unread.csv"), {"config": {"max_env_steps": 6_000_000, "stop_success_share": 0.9}}, measured)
+    assert text == ("53 env steps/s lately, about 25.5 h to its budget of 6,000,000 env steps "
+                    "(its stop rule may end it sooner)")
+    assert pace_text(Path("unread.csv"), {"config": {"max_env_steps": 6_000_000}}, measured).endswith("env steps")
