@@ -207,7 +207,7 @@ def region_bars(page: str, arg: str) -> str:
     rows = []
     for name in experiment_names():
         for model, bar in get_experiment(name).bars.items():
-            rows.append([name, model, bar.describe(), bar.reason])
+            rows.append([name, model, bar.describe(success_word(name, model)), bar.reason])
             if bar.over_seeds:
                 seeds = bar.over_seeds
                 rows.append([name, f"{model}, its recipe over seeds",

@@ -8,7 +8,7 @@ import re
 
 from rlcore.docgen_data import Model
 from rlcore.experiment import get_experiment
-from rlcore.score_words import hours, return_digits, score_words  # noqa: F401 (hours: the docs' parts import it here)
+from rlcore.score_words import hours, return_digits, score_words, success_word  # noqa: F401 (hours: the docs' parts import it here)
 
 
 def num(value: float, digits: int = 1) -> str:
@@ -50,7 +50,7 @@ def eval_text(model: Model) -> str:
 def bar_text(model: Model) -> str:
     if model.bar is None:
         return "none set"
-    return model.bar.describe()
+    return model.bar.describe(success_word(model.experiment, model.name))
 
 
 def bar_met(model: Model) -> str:

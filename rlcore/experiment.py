@@ -81,10 +81,11 @@ class Bar:
             return False
         return self.full_length_share is None or evaluation.get("time_limit_share", 0.0) >= self.full_length_share
 
-    def describe(self) -> str:
-        """``mean return >= 230`` or ``flag in >= 50 % of episodes``, for cards and tables."""
+    def describe(self, success: str = "success") -> str:
+        """``mean return >= 230`` or ``flag in >= 50% of episodes`` (``success``: what a successful episode
+        reaches, :func:`rlcore.score_words.success_word`), for cards, tables and the console."""
         if self.metric == "success_share":
-            text = f"success in >= {self.value:.0%} of episodes"
+            text = f"{success} in >= {self.value:.0%} of episodes"
         else:
             text = f"mean return >= {self.value:g}"
         if self.full_length_share is not None:

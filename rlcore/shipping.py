@@ -166,7 +166,9 @@ def _bar_words(exp, meta: dict | None, summary: dict, seed_base: int) -> str:
     elif seeds.start < periodic.stop and periodic.start < seeds.stop:
         caveats.append("on the seeds of the periodic evaluations that chose the model's weights")
     verdict = "met" if bar.met_by(summary) else "not met"
-    return f"; the shipped model's bar ({bar.describe()}): {verdict}" + (f" ({'; '.join(caveats)})" if caveats else "")
+    name = model_name(exp, meta) or str(meta.get("algo", ""))
+    return (f"; the shipped model's bar ({bar.describe(success_word(exp.name, name))}): {verdict}"
+            + (f" ({'; '.join(caveats)})" if caveats else ""))
 
 
 def evaluate_into_meta(model_dir: Path, episodes: int, seed_base: int | None = None,
@@ -281,7 +283,8 @@ def publish_refusal(experiment, target: Path, meta: dict) -> str | None:
                 f"{experiment.eval_episodes}")
     bar = experiment.bar(target.name)
     if bar is not None and not bar.met_by(evaluation):
-        return f"its evaluation misses the bar of the shipped {target.name} ({bar.describe()})"
+        return (f"its evaluation misses the bar of the shipped {target.name} "
+                f"({bar.describe(success_word(experiment.name, target.name))})")
     return None
 
 

@@ -403,7 +403,7 @@ def test_publish_refusal_reads_the_bar_of_the_folder_it_would_replace():
         mario, Path("saved/mario_ppo/1-2"), {"evaluation": {"success_share": 1.0, "episodes": 1}})
     flags = {"evaluation": {"success_share": 0.6, "episodes": 10}}  # 6 of 10: enough for 1-2, not for 1-1
     assert publish_refusal(mario, Path("saved/mario_ppo/1-2"), flags) is None
-    assert "1-1 (success in >= 80% of episodes)" in publish_refusal(mario, Path("saved/mario_ppo/1-1"), flags)
+    assert "1-1 (flag in >= 80% of episodes)" in publish_refusal(mario, Path("saved/mario_ppo/1-1"), flags)
 
 
 def test_a_folder_that_takes_no_new_files_is_said_so_not_missing():
