@@ -139,7 +139,9 @@ def kept_sweeps() -> dict[tuple[str, str], Sweep]:
         for line in report.splitlines():
             if m := _AGGREGATE_ROW.match(line.strip()):
                 aggregates.setdefault(m[1], (float(m[2]), float(m[3]), float(m[4])))
-        reported = sorted(float(s) for s in re.findall(r"^\| [^|]+ \| \d+ \| (-?[\d.]+) \|", report, re.M))
+        # a run's row: | trial | seed | score | ..., a goal's share with the episodes behind it: 0.800 (8 of 10)
+        reported = sorted(float(s) for s in re.findall(r"^\| [^|]+ \| \d+ \| (-?[\d.]+)(?: \(\d+ of \d+\))? \|",
+                                                       report, re.M))
         if reported != sorted(round(s, 3) for _, s in seeds):
             raise SystemExit(f"error: {folder.relative_to(REPO)}/report.md does not list the scores of its runs' "
                              f"meta.json; rerun `python main.py report {folder.relative_to(REPO)}`")

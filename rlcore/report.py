@@ -34,6 +34,7 @@ def load_runs(sweep_dir: Path) -> list[dict]:
             unevaluated.append(meta_path.parent.parent.name)  # trained but not evaluated: no score
             continue
         rows.append({"trial": meta_path.parent.parent.name, "seed": meta["seed"], "score": float(score),
+                     "goal": _goal_word(meta) if "success_share" in ev else None,
                      "eval_episodes": ev.get("episodes"), "env_steps": meta["env_steps"],
                      "wall_seconds": meta["wall_seconds"], "run_dir": meta_path.parent.parent,
                      "cpu": cpus_text(meta), "time_limit_share": ev.get("time_limit_share"),
@@ -52,6 +53,14 @@ def load_runs(sweep_dir: Path) -> list[dict]:
         raise UserError(f"{sweep_dir} holds runs of {' and '.join(kinds)}: a report aggregates one experiment "
                         f"and algorithm per folder; give each its own SWEEP_DIR")
     return rows
+
+
+def _goal_word(meta: dict) -> str:
+    """What a run's successful episodes reach (Mario: flag, or axe on x-4), as the cards say it."""
+    from rlcore.score_words import success_word
+
+    config = meta.get("config") or {}
+    return success_word(str(meta.get("experiment")), f"{config.get('world')}-{config.get('stage')}", other="goal")
 
 
 def _solved_score(meta: dict) -> float | None:
@@ -106,10 +115,13 @@ def share_text(share: float | None) -> str:
 def markdown(result: dict) -> str:
     lines = []
     for s in result["sweeps"]:
+        goals = {r["goal"] for r in s["runs"]}
+        # a goal's runs are scored by the share of episodes reaching it (Mario: "flag share 0.800 (8 of 10)")
+        score = f"{goals.pop()} share" if len(goals) == 1 and None not in goals else "final score"
         lines += [f"## {s['label']} ({s['folder']})", "",
-                  "| run | seed | final score (unseen seeds) | to time limit | env steps | wall | env steps/s | CPU |",
+                  f"| run | seed | {score} (unseen seeds) | to time limit | env steps | wall | env steps/s | CPU |",
                   "| --- | ---: | ---: | ---: | ---: | ---: | ---: | --- |"]
-        lines += [f"| {r['trial']} | {r['seed']} | {r['score']:.3f} | {share_text(r.get('time_limit_share'))} "
+        lines += [f"| {r['trial']} | {r['seed']} | {r['score']:.3f}{_of(r)} | {share_text(r.get('time_limit_share'))} "
                   f"| {r['env_steps']:,} | {r['wall_seconds']:.0f} s | {r['env_steps'] / max(r['wall_seconds'], 1e-9):,.0f} "
                   f"| {r.get('cpu') or 'not recorded'} |" for r in s["runs"]]
         lines += ["", f"| over {count(len(s['runs']), 'run')} | point | 95% CI (stratified bootstrap) |",
@@ -117,8 +129,9 @@ def markdown(result: dict) -> str:
         lines += [f"| {name} | {p:.3f} | [{lo:.3f}, {hi:.3f}] |" for name, (p, lo, hi) in s["aggregates"].items()]
         if any(r.get("further") for r in s["runs"]):
             lines += ["", "Further evaluations on other unseen seeds (`evaluate --record-further`), each run's in order:",
-                      ""] + [f"- {r['trial']}: " + ("; ".join(f"{score:.3f} over {episodes} episodes"
-                                                             for episodes, score in r["further"]) or "none")
+                      ""] + [f"- {r['trial']}: " + ("; ".join(f"{score:.3f} " + (
+                                 f"({round(score * episodes)} of {episodes} episodes)" if r.get("goal")
+                                 else f"over {episodes} episodes") for episodes, score in r["further"]) or "none")
                              for r in s["runs"]]
         lines += ["", *stability_lines(s["runs"]), ""]
         if critic := critic_lines(s["runs"]):
@@ -128,6 +141,13 @@ def markdown(result: dict) -> str:
         first, second = (s["label"] for s in result["sweeps"])
         lines += [f"P({first} > {second}) = {p:.3f} [{lo:.3f}, {hi:.3f}]", ""]
     return "\n".join(lines)
+
+
+def _of(run: dict) -> str:
+    """`` (8 of 10)`` beside a goal's share: the episodes behind it; nothing beside a mean return."""
+    if not run.get("goal") or not run.get("eval_episodes"):
+        return ""
+    return f" ({round(run['score'] * run['eval_episodes'])} of {run['eval_episodes']})"
 
 
 def stability_lines(runs: list[dict]) -> list[str]:

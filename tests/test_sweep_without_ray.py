@@ -226,8 +226,10 @@ def test_single_runs_over_seeds_are_kept_and_reported_as_a_sweep_of_their_level(
     sweep = json.loads((kept / "sweep.json").read_text())
     assert (sweep["seeds"], sweep["overrides"], sweep["preset"]) == ([0, 1, 2], {"world": 1, "stage": 1}, "default")
     report = (kept / "report.md").read_text()
-    assert "| seed=2 | 2 | 0.600 |" in report and "| median | 0.900 |" in report
-    assert "- seed=0: 0.900 over 30 episodes" in report and "- seed=1: none" in report
+    # scored by the flag: the share and the episodes behind it
+    assert "| run | seed | flag share (unseen seeds) |" in report
+    assert "| seed=2 | 2 | 0.600 (6 of 10) |" in report and "| median | 0.900 |" in report
+    assert "- seed=0: 0.900 (27 of 30 episodes)" in report and "- seed=1: none" in report
     monkeypatch.setattr(docgen_data, "REPO", tmp_path)
     found = docgen_data.kept_sweeps()
     assert list(found) == [("mario_ppo", "1-1")] and found[("mario_ppo", "1-1")].seeds == [(0, 0.9), (1, 1.0), (2, 0.6)]
