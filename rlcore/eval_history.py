@@ -27,6 +27,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from rlcore.errors import UserError
+from rlcore.score_words import count
 
 DROP, RECOVER, LEARNT, LEAST = 0.25, 0.75, 0.5, 0.25
 
@@ -151,7 +152,7 @@ def story_text(s: Story, digits: int = 2) -> str:
         parts = ["no evaluation a quarter of the way to the solved score"
                  + (f" (best {s.best.mean:.{digits}f})" if s.best is not None else "") + ": no dip counts as a collapse"]
     else:
-        parts = [f"{len(s.collapses)} collapse{'s' if len(s.collapses) != 1 else ''}"
+        parts = [count(len(s.collapses), 'collapse')
                  + (f" ({'; '.join(collapse_text(c, digits) for c in s.collapses)})" if s.collapses else "")]
     if s.kept_best and s.best is not None:
         parts.append(f"model: weights of the best evaluation ({s.best.mean:.{digits}f} at {steps_text(s.best.env_steps)})"

@@ -35,6 +35,7 @@ def load_runs(sweep_dir: Path) -> list[dict]:
             continue
         rows.append({"trial": meta_path.parent.parent.name, "seed": meta["seed"], "score": float(score),
                      "goal": _goal_word(meta) if "success_share" in ev else None,
+                     "stop_share": (meta.get("config") or {}).get("stop_success_share") or None,
                      "eval_episodes": ev.get("episodes"), "env_steps": meta["env_steps"],
                      "wall_seconds": meta["wall_seconds"], "run_dir": meta_path.parent.parent,
                      "cpu": cpus_text(meta), "time_limit_share": ev.get("time_limit_share"),
@@ -56,11 +57,14 @@ def load_runs(sweep_dir: Path) -> list[dict]:
 
 
 def _goal_word(meta: dict) -> str:
-    """What a run's successful episodes reach (Mario: flag, or axe on x-4), as the cards say it."""
+    """What a run's successful episodes reach (Mario: flag, or axe on x-4), as the cards say it: the model's
+    name read from its config as its shipped folder would have it (:func:`rlcore.shipping.model_name`)."""
+    from rlcore.experiment import get_experiment
     from rlcore.score_words import success_word
+    from rlcore.shipping import model_name
 
-    config = meta.get("config") or {}
-    return success_word(str(meta.get("experiment")), f"{config.get('world')}-{config.get('stage')}", other="goal")
+    exp = get_experiment(meta["experiment"])
+    return success_word(exp.name, model_name(exp, meta), other="goal")
 
 
 def _solved_score(meta: dict) -> float | None:

@@ -108,20 +108,10 @@ def plot_curves(result: dict, out: Path, reps: int = 1000, column: str = AVERAGE
 
 
 def _goal(sweeps: list[dict]) -> tuple[str, float | None]:
-    """What the runs' successful episodes reach, as the cards say it (Mario: flag, or axe on x-4), and the
+    """What the runs' successful episodes reach (Mario: flag, or axe on x-4; ``load_runs``'s ``goal``), and the
     success share their stop rule ends them at (``--stop-success-share``), where all runs have the same."""
-    import json
-
-    from rlcore.score_words import success_word
-
-    words, stops = set(), set()
-    for s in sweeps:
-        for r in s["runs"]:
-            meta = json.loads((Path(r["run_dir"]) / "model" / "meta.json").read_text())
-            config = meta.get("config", {})
-            level = f"{config.get('world')}-{config.get('stage')}"
-            words.add(success_word(meta.get("experiment", ""), level, other="goal"))
-            stops.add(config.get("stop_success_share") or None)
+    words = {r.get("goal") or "goal" for s in sweeps for r in s["runs"]}
+    stops = {r.get("stop_share") for s in sweeps for r in s["runs"]}
     return (words.pop() if len(words) == 1 else "goal"), (stops.pop() if len(stops) == 1 else None)
 
 

@@ -262,11 +262,14 @@ def test_a_goal_tasks_report_draws_the_success_share_the_stop_rule_reads(tmp_pat
     x-4 ends at the axe."""
     from rlcore.report_plots import SUCCESS_SHARE, _goal, run_curve
 
-    runs = [{"run_dir": _mario_run(tmp_path / f"run{s}", s, 8, stop_success_share=0.9)} for s in range(2)]
+    for s in range(2):
+        _mario_run(tmp_path / "runs" / f"seed={s}", s, 8, stop_success_share=0.9)
+    runs = load_runs(tmp_path / "runs")  # the rows the report draws from
     steps, shares = run_curve(runs[0]["run_dir"], SUCCESS_SHARE)
     assert steps.tolist() == [10.0, 1000.0] and shares.tolist() == [0.0, 0.5]
     assert _goal([{"runs": runs}]) == ("flag", 0.9)
-    castle = {"run_dir": _mario_run(tmp_path / "castle", 2, 8, stage=4, stop_success_share=0.8)}
+    _mario_run(tmp_path / "castles" / "seed=2", 2, 8, stage=4, stop_success_share=0.8)
+    [castle] = load_runs(tmp_path / "castles")
     assert _goal([{"runs": [castle]}]) == ("axe", 0.8)
     assert _goal([{"runs": runs + [castle]}]) == ("goal", None)  # unlike runs: no one word, no one stop share
 
