@@ -222,16 +222,18 @@ def evaluate(model: ModelRef | Policy, episodes: int | None = None, seed_base: i
 def render(model: ModelRef | Policy, out: str | os.PathLike[str] = "video.mp4", episodes: int | None = None,
            seed: int | None = None, fps: int | None = None) -> Path:
     """Film ``episodes`` episodes (default the experiment's, 1; Minitaur 3) into ``out``: an ``.mp4``,
-    or a small looping ``.gif``. Episode i is seeded ``seed + i`` (default the first evaluation seed).
+    a small looping ``.gif``, or a folder (``EXPERIMENT_ALGO.mp4`` in it). Episode i is seeded ``seed + i`` (default the first evaluation seed).
     Returns the path written."""
     from rlcore.atomic import writable_folder
-    from rlcore.video import check_video_path
+    from rlcore.trainers.spec import folder_safe
+    from rlcore.video import video_path
 
-    path = check_video_path(Path(out))
+    video_path(out, "video")  # a bad name is refused before the model loads
     check_whole("episodes", episodes, EVAL_COUNT, none_ok=True)
     check_whole("seed", seed, NON_NEGATIVE, none_ok=True)
     check_whole("fps", fps, FRAME_RATE, none_ok=True)
     policy = load(model)
+    path = video_path(out, f"{folder_safe(policy.experiment.name)}_{policy.algo}")  # a folder gets the model's name
     writable_folder(path.parent, "out")
     render_policy(policy, path, fps, episodes, seed)
     return path

@@ -125,11 +125,8 @@ def cmd_render(args) -> int:
     from rlcore.policies import load_policy
 
     name = _output_name(args)
-    out = Path(args.out) if args.out else Path("videos") / f"{name}.mp4"
-    if out.is_dir() or (args.out and (args.out.endswith("/") or not out.suffix)):  # a folder, made if new
-        out = out / f"{name}.mp4"
-    from rlcore.video import check_video_path
-    out = check_video_path(out)  # .mp4 or .gif (by the suffix), else one line
+    from rlcore.video import video_path
+    out = video_path(args.out or "videos", name)  # .mp4 or .gif (by the suffix), or a folder, else one line
     with _model(args) as (model_dir, _):
         load_policy(model_dir, args.experiment, args.algo)  # checks before any file is written
         writable_folder(out.parent, "--out")

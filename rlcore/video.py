@@ -3,6 +3,7 @@ to a small looping GIF (imageio's Pillow plugin), chosen by the file's suffix.""
 from __future__ import annotations
 
 import math
+import os
 from functools import partial
 from pathlib import Path
 
@@ -93,6 +94,17 @@ def _shrink(frame: np.ndarray) -> np.ndarray:
 
     size = (GIF_WIDTH, max(1, round(height * GIF_WIDTH / width)))
     return np.asarray(Image.fromarray(frame).resize(size, Image.Resampling.LANCZOS))
+
+
+def video_path(out: str | os.PathLike, name: str) -> Path:
+    """Where a video given as ``out`` goes: ``out`` itself if it names an MP4 or a GIF; ``out/NAME.mp4`` if
+    it is a folder (one that exists, or a path that ends in '/' or has no suffix, made when written);
+    else one clear error (:func:`check_video_path`)."""
+    text = os.fspath(out)
+    path = Path(text)
+    if path.is_dir() or text.endswith(("/", os.sep)) or not path.suffix:
+        path = path / f"{name}.mp4"
+    return check_video_path(path)
 
 
 def check_video_path(path: str | Path) -> Path:

@@ -109,6 +109,8 @@ def test_train_records_the_call_evaluates_and_renders(tmp_path):
     import imageio.v2 as imageio
     with imageio.get_reader(video) as reader:  # decoded by ffmpeg (imageio-ffmpeg)
         assert video == tmp_path / "clip.mp4" and reader.count_frames() > 1
+    # a folder, as the command line's --out takes one: made, the video named after the model
+    assert api.render(run, f"{tmp_path / 'clips'}/", episodes=1) == tmp_path / "clips" / "cartpole_dqn.mp4"
     with pytest.raises(UserError, match="already holds a run"):
         api.train("cartpole", "dqn", run_dir=tmp_path / "run", episodes=1)
     with pytest.raises(UserError, match="^episodes and max_episodes set the same budget"):
