@@ -135,9 +135,11 @@ def _add_evaluate_and_render(sub, episodes: str) -> None:
     """``evaluate`` (a saved model on unseen seeds, recorded or not) and ``render`` (a video of it)."""
     from rlcore.experiment import experiment_names
 
-    for name, text in (("evaluate", "greedy mean +- std of a saved model on unseen seeds "
-                                    "(Mario: share of episodes reaching the flag, x position)"),
-                       ("render", "an MP4 or GIF of a saved model playing (greedily; Mario samples from pi)")):
+    for name, text in (("evaluate", "mean +- std of a saved model's return on unseen seeds, acting greedily "
+                                    "(SAC: its mean action; Mario: actions drawn from pi, and the share of "
+                                    "episodes reaching the flag)"),
+                       ("render", "an MP4 or GIF of a saved model playing as evaluate plays it (greedily; SAC "
+                                  "its mean action; Mario draws from pi)")):
         p = sub.add_parser(name, help=text, description=text)
         _add_model_choice(p, experiment_names())
         if name == "evaluate":
