@@ -162,3 +162,23 @@ def test_the_site_hook_points_repository_links_at_the_mounted_copies():
     assert site_links(text, page) == ("![plot](../saved_networks/mario_ppo/1-1/a.png) "
                                       "[report](../results/sweeps/x/report.md#iqm) [api](../api.md) "
                                       "[web](https://example.org/saved_networks/a.png)")
+
+
+def test_no_wrapped_line_starts_a_numbered_list_by_accident():
+    """A paragraph whose wrapped line begins "10. " starts a new list item on the site (Python-Markdown reads
+    it so; GitHub does not): the Mario page's reward item broke off at "all divided by" that way. Every
+    numbered line of a page continues the list above it at its indent (1 after nothing, n after n-1)."""
+    pages = DOC_FILES + sorted((REPO / "saved_networks").rglob("*.md")) + sorted((REPO / "results").rglob("*.md"))
+    item = re.compile(r"^( *)(\d+)\. ")
+    bad = []
+    for path in pages:
+        text = re.sub(r"```.*?```", lambda m: "\n" * m.group().count("\n"), path.read_text(), flags=re.S)
+        last: dict[str, int] = {}  # indent -> the number of the last item at that indent
+        for number, line in enumerate(text.splitlines(), 1):
+            match = item.match(line)
+            if match:
+                indent, n = match.group(1), int(match.group(2))
+                if n != 1 and last.get(indent) != n - 1:
+                    bad.append(f"{path.relative_to(REPO)}:{number}: {line.strip()[:60]}")
+                last[indent] = n
+    assert not bad, bad
