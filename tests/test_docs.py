@@ -182,3 +182,26 @@ def test_no_wrapped_line_starts_a_numbered_list_by_accident():
                     bad.append(f"{path.relative_to(REPO)}:{number}: {line.strip()[:60]}")
                 last[indent] = n
     assert not bad, bad
+
+
+def test_every_list_stands_apart_from_the_paragraph_above_it():
+    """A list right under a paragraph line, with no blank line between, is a list on GitHub but run-on text
+    on the site (Python-Markdown): "Why:" then "- 1-3 is the treetop level ..." read as one paragraph with
+    dashes in it on five pages of notes and training logs."""
+    pages = DOC_FILES + sorted((REPO / "saved_networks").rglob("*.md")) + sorted((REPO / "results").rglob("*.md"))
+    item = re.compile(r"^\s*([-*+]|\d+\.)\s")
+    not_a_paragraph = re.compile(r"^\s*([-*+]\s|\d+\.\s|#|\||<|!!!|\?\?\?|>)")
+    bad = []
+    for path in pages:
+        text = re.sub(r"\A---\n.*?\n---\n", lambda m: "\n" * m.group().count("\n"), path.read_text(), flags=re.S)
+        lines = re.sub(r"```.*?```", lambda m: "\n" * m.group().count("\n"), text, flags=re.S).splitlines()
+        start = None  # the first line of the block the line belongs to
+        for number, line in enumerate(lines):
+            if not line.strip():
+                start = None
+                continue
+            start = number if start is None else start
+            if (item.match(line) and number != start and not not_a_paragraph.match(lines[start])
+                    and not any(item.match(lines[above]) for above in range(start, number))):
+                bad.append(f"{path.relative_to(REPO)}:{number + 1}: {line.strip()[:60]}")
+    assert not bad, bad
