@@ -21,7 +21,8 @@ import re
 import sys
 
 from rlcore.docgen_data import REPO, Model, shipped_models
-from rlcore.experiment import get_experiment, experiment_names
+from rlcore.docgen_reference import (region_bars, region_csv_columns, region_meta_keys, region_presets,
+                                     region_seed_ranges)
 from rlcore.score_words import success_word
 from rlcore.docgen_words import (OVER_SEEDS_HEADER, article_of, bar_met, bar_text, hours, link, model_page,
                                  over_seeds_cell, ret, score_text, sweep_score, table)
@@ -166,82 +167,11 @@ def region_curves(page: str, experiment: str) -> str:
     return "\n\n".join(parts) or "*No curves shipped.*"
 
 
-def region_csv_columns(page: str, arg: str) -> str:
-    """The columns of each CSV a shipped model folder holds (of experiment ARG, or all), read from the
-    files themselves: every column any of them holds (a model trained before a column was added lacks
-    it; one marked * is in some of the files only)."""
-    seen: dict[tuple[str, str, str], list[list[str]]] = {}
-    for m in shipped_models():
-        if arg and m.experiment not in arg.split("/"):
-            continue
-        for csv_path in sorted((REPO / m.folder).glob("*.csv")):
-            with csv_path.open() as f:
-                seen.setdefault((m.experiment, m.meta.get("kind", m.algo), csv_path.name), []).append(
-                    f.readline().strip().split(","))
-    rows = []
-    for (experiment, kind, name), headers in seen.items():
-        columns = list(dict.fromkeys(c for header in headers for c in header))
-        rows.append([f"`{name}`", experiment, kind, ", ".join(
-            f"`{c}`" + ("" if all(c in header for header in headers) else "*") for c in columns)])
-    partial = any(row[3].count("*") for row in rows)
-    return table(["file", "experiment", "trainer", "columns"], rows) + (
-        "\n\n\\* in some of the shipped models' files only: those trained before it was added lack it." if partial else "")
-
-
-def region_meta_keys(page: str, arg: str) -> str:
-    """Which keys the shipped meta.json files hold, and in how many of them."""
-    counts: dict[str, int] = {}
-    models = shipped_models()
-    for m in models:
-        for key in m.meta:
-            counts[key] = counts.get(key, 0) + 1
-        for key in m.evaluation:
-            counts[f"evaluation.{key}"] = counts.get(f"evaluation.{key}", 0) + 1
-    return table(["key", "in shipped meta.json files"],
-                 [[f"`{k}`", f"{n} of {len(models)}"] for k, n in counts.items()], "lr")
-
-
-def region_bars(page: str, arg: str) -> str:
-    """Every bar in the registry with its reason, and where one is set, the recipe's bar over seeds (its
-    kept sweep's statistic) with its own."""
-    rows = []
-    for name in experiment_names():
-        for model, bar in get_experiment(name).bars.items():
-            rows.append([name, model, bar.describe(success_word(name, model)), bar.reason])
-            if bar.over_seeds:
-                seeds = bar.over_seeds
-                rows.append([name, f"{model}, its recipe over seeds",
-                             seeds.describe(bar.metric == "success_share"), seeds.reason])
-    return table(["experiment", "model", "bar", "why this number"], rows)
-
-
-def region_presets(page: str, arg: str) -> str:
-    from rlcore.docgen_reference import preset_differences
-
-    return preset_differences(arg, link(page, "docs/reference/hyperparameters.md"))
-
-
-def region_seed_ranges(page: str, arg: str) -> str:
-    """Which seeds evaluate, select and train, per experiment, from the registry and rlcore.seeding."""
-    from rlcore import seeding
-
-    rows = []
-    for name in experiment_names():
-        exp = get_experiment(name)
-        rows.append([name, f"{exp.eval_episodes}", f"from {exp.eval_seed_base:,}", f"from {exp.selection_seed_base:,}"])
-    text = table(["experiment", "final evaluation episodes", "final evaluation seeds", "selection seeds"], rows, "lrrr")
-    zero = seeding.seed_block(0)
-    one = seeding.seed_block(1)
-    return text + (f"\n\nTraining env seeds stay below {seeding.TRAINING_SEED_SPAN:,}: run seed 0 uses "
-                   f"{zero.start:,}-{zero.stop - 1:,}, and each run seed from 1 to {seeding.MAX_RUN_SEED} owns "
-                   f"its own block of {len(one):,} (seed 1: {one.start:,}-{one.stop - 1:,}).")
-
-
-REGIONS = {"results-table": region_results_table, "gif-strip": region_gif_strip, "shipped": region_shipped,
+REGIONS = {"csv-columns": region_csv_columns, "meta-keys": region_meta_keys, "bars": region_bars,
+           "seed-ranges": region_seed_ranges, "presets": region_presets,
+           "results-table": region_results_table, "gif-strip": region_gif_strip, "shipped": region_shipped,
            "sweeps": region_sweeps, "sweep-stability": region_sweep_stability,
-           "seed-summary": region_seed_summary, "seed-runs": region_seed_runs, "curves": region_curves, "csv-columns": region_csv_columns,
-           "meta-keys": region_meta_keys, "bars": region_bars,
-           "seed-ranges": region_seed_ranges, "presets": region_presets}
+           "seed-summary": region_seed_summary, "seed-runs": region_seed_runs, "curves": region_curves}
 _REGION = re.compile(r"(<!-- generated:([\w-]+)(?: ([\w./-]+))? -->\n)(.*?)(<!-- /generated -->)", re.S)
 
 

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import json
 
-from rlcore.docgen import EXPERIMENT_PAGES, region_bars, region_shipped, region_sweeps
+from rlcore.docgen import EXPERIMENT_PAGES, region_shipped, region_sweeps
+from rlcore.docgen_reference import region_bars
 from rlcore.docgen_data import GENERATED_NOTE, REPO, Model
 from rlcore.docgen_words import (OVER_SEEDS_HEADER, article_of, bar_met, bar_text, eval_text, link, model_page, num,
                                  over_seeds_bold, over_seeds_cell, policy_text, ret, score_text, sweep_score, table)

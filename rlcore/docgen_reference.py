@@ -1,14 +1,17 @@
 """The reference pages: the CLI (from the real argparse parser) and every hyperparameter of every
-experiment x algorithm x preset (from the registry's dataclasses). Part of :mod:`rlcore.docgen`."""
+experiment x algorithm x preset (from the registry's dataclasses); and the regions of hand-written pages
+that state reference facts: the CSV columns and meta.json keys of the shipped models, the bars, the
+presets' differences, the seed ranges. Part of :mod:`rlcore.docgen`."""
 from __future__ import annotations
 
 import argparse
 import dataclasses
 
 from rlcore.allowed import field_words
-from rlcore.docgen_data import GENERATED_NOTE
-from rlcore.docgen_words import table
+from rlcore.docgen_data import GENERATED_NOTE, REPO, shipped_models
+from rlcore.docgen_words import link, table
 from rlcore.experiment import experiment_names, get_experiment
+from rlcore.score_words import success_word
 
 HELP_WIDTH = 100  # fixed, so the page does not depend on the terminal that generated it
 
@@ -100,3 +103,74 @@ def preset_differences(experiment: str, reference: str) -> str:
                   table(["flag", *[f"`{p}`" for p in names]], [list(r) for r in rows]), ""]
     parts.append(f"Every other field is the same in all presets: see [hyperparameters]({reference}#{experiment}).")
     return "\n".join(parts)
+
+
+# ------------------------------------------------------------------ regions of hand-written pages
+def region_csv_columns(page: str, arg: str) -> str:
+    """The columns of each CSV a shipped model folder holds (of experiment ARG, or all), read from the
+    files themselves: every column any of them holds (a model trained before a column was added lacks
+    it; one marked * is in some of the files only)."""
+    seen: dict[tuple[str, str, str], list[list[str]]] = {}
+    for m in shipped_models():
+        if arg and m.experiment not in arg.split("/"):
+            continue
+        for csv_path in sorted((REPO / m.folder).glob("*.csv")):
+            with csv_path.open() as f:
+                seen.setdefault((m.experiment, m.meta.get("kind", m.algo), csv_path.name), []).append(
+                    f.readline().strip().split(","))
+    rows = []
+    for (experiment, kind, name), headers in seen.items():
+        columns = list(dict.fromkeys(c for header in headers for c in header))
+        rows.append([f"`{name}`", experiment, kind, ", ".join(
+            f"`{c}`" + ("" if all(c in header for header in headers) else "*") for c in columns)])
+    partial = any(row[3].count("*") for row in rows)
+    return table(["file", "experiment", "trainer", "columns"], rows) + (
+        "\n\n\\* in some of the shipped models' files only: those trained before it was added lack it." if partial else "")
+
+
+def region_meta_keys(page: str, arg: str) -> str:
+    """Which keys the shipped meta.json files hold, and in how many of them."""
+    counts: dict[str, int] = {}
+    models = shipped_models()
+    for m in models:
+        for key in m.meta:
+            counts[key] = counts.get(key, 0) + 1
+        for key in m.evaluation:
+            counts[f"evaluation.{key}"] = counts.get(f"evaluation.{key}", 0) + 1
+    return table(["key", "in shipped meta.json files"],
+                 [[f"`{k}`", f"{n} of {len(models)}"] for k, n in counts.items()], "lr")
+
+
+def region_bars(page: str, arg: str) -> str:
+    """Every bar in the registry with its reason, and where one is set, the recipe's bar over seeds (its
+    kept sweep's statistic) with its own."""
+    rows = []
+    for name in experiment_names():
+        for model, bar in get_experiment(name).bars.items():
+            rows.append([name, model, bar.describe(success_word(name, model)), bar.reason])
+            if bar.over_seeds:
+                seeds = bar.over_seeds
+                rows.append([name, f"{model}, its recipe over seeds",
+                             seeds.describe(bar.metric == "success_share"), seeds.reason])
+    return table(["experiment", "model", "bar", "why this number"], rows)
+
+
+def region_presets(page: str, arg: str) -> str:
+    """How the presets of experiment ARG differ, field by field, linking the hyperparameters page."""
+    return preset_differences(arg, link(page, "docs/reference/hyperparameters.md"))
+
+
+def region_seed_ranges(page: str, arg: str) -> str:
+    """Which seeds evaluate, select and train, per experiment, from the registry and rlcore.seeding."""
+    from rlcore import seeding
+
+    rows = []
+    for name in experiment_names():
+        exp = get_experiment(name)
+        rows.append([name, f"{exp.eval_episodes}", f"from {exp.eval_seed_base:,}", f"from {exp.selection_seed_base:,}"])
+    text = table(["experiment", "final evaluation episodes", "final evaluation seeds", "selection seeds"], rows, "lrrr")
+    zero = seeding.seed_block(0)
+    one = seeding.seed_block(1)
+    return text + (f"\n\nTraining env seeds stay below {seeding.TRAINING_SEED_SPAN:,}: run seed 0 uses "
+                   f"{zero.start:,}-{zero.stop - 1:,}, and each run seed from 1 to {seeding.MAX_RUN_SEED} owns "
+                   f"its own block of {len(one):,} (seed 1: {one.start:,}-{one.stop - 1:,}).")

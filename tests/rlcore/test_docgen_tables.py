@@ -2,7 +2,7 @@
 what the whole chain cost, and the CSV columns are those of every shipped file, not the first one's."""
 from __future__ import annotations
 
-from rlcore import docgen, docgen_data
+from rlcore import docgen, docgen_data, docgen_reference
 
 
 def _model(tmp_path, name, meta, header=None):
@@ -37,10 +37,10 @@ def test_a_chain_of_init_from_runs_is_added_up_and_named(tmp_path, monkeypatch):
 def test_csv_columns_are_those_of_every_file(tmp_path, monkeypatch):
     old = _model(tmp_path, "1-2", {}, "rollout,env_steps,loss")
     new = _model(tmp_path, "1-1", {}, "rollout,env_steps,loss,lr")
-    monkeypatch.setattr(docgen, "REPO", tmp_path)
-    monkeypatch.setattr(docgen, "shipped_models", lambda: [old, new])
-    text = docgen.region_csv_columns("docs/x.md", "mario_ppo")
+    monkeypatch.setattr(docgen_reference, "REPO", tmp_path)
+    monkeypatch.setattr(docgen_reference, "shipped_models", lambda: [old, new])
+    text = docgen_reference.region_csv_columns("docs/x.md", "mario_ppo")
     assert "| `rollouts.csv` | mario_ppo | ppo | `rollout`, `env_steps`, `loss`, `lr`* |" in text
     assert "in some of the shipped models' files only" in text
-    monkeypatch.setattr(docgen, "shipped_models", lambda: [new])
-    assert "*" not in docgen.region_csv_columns("docs/x.md", "mario_ppo").replace("`", "")
+    monkeypatch.setattr(docgen_reference, "shipped_models", lambda: [new])
+    assert "*" not in docgen_reference.region_csv_columns("docs/x.md", "mario_ppo").replace("`", "")
