@@ -65,6 +65,7 @@ benchmark: $(ALL)
 	$(PY) benchmarks/mario.py
 	$(PY) benchmarks/minitaur.py
 	$(PY) benchmarks/sweep.py
+	$(PY) benchmarks/report.py
 
 # The docs: regenerate every generated page, card and README region from the artefacts, then build the
 # site into build/site/. docs-check changes nothing: it fails on drift or on a broken link (make test
