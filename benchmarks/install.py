@@ -47,10 +47,10 @@ def install(tool: str, target: str, cache: bool, python: str) -> float:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--extras", default="", help="e.g. all, or mario,sweep (default: the core only)")
-    parser.add_argument("--tools", default="pip,uv")
-    parser.add_argument("--python", default="python3.13")
+    parser.add_argument("--tools", default="pip,uv", help="the installers to time, comma-separated (default pip,uv)")
+    parser.add_argument("--python", default="python3.13", help="the Python each fresh venv is made with")
     args = parser.parse_args()
     target = f".[{args.extras}]" if args.extras else "."
     for tool in args.tools.split(","):
