@@ -263,9 +263,10 @@ def export(model: ModelRef | Policy, format: ExportFormat, out: str | os.PathLik
 
     policy = load(model)
     load_tensorflow()
+    # a run in progress is exported from its last checkpoint, and its record says so, as the CLI's does
+    source = f"{policy.model_dir}, last checkpoint" if policy._keep is not None else str(policy.model_dir)
     with _snapshot_folder(policy) as folder:
-        record: dict[str, Any] = export_model(folder, format, out, observations=observations,
-                                              source=str(policy.model_dir))
+        record: dict[str, Any] = export_model(folder, format, out, observations=observations, source=source)
     return record
 
 

@@ -181,6 +181,9 @@ def test_a_run_in_progress_loads_from_its_checkpoint(tmp_path):
     policy = api.load(tmp_path / "run")
     assert policy.meta["snapshot_of"].endswith("checkpoint.npz")
     assert api.evaluate(policy, episodes=1)["episodes"] == 1
+    # its export records where it came from as `main.py export` does: the run folder, its last checkpoint
+    record = api.export(policy, "savedmodel", tmp_path / "export", observations=16)
+    assert record["source_model"] == f"{tmp_path / 'run'}, last checkpoint"
 
 
 def test_notebook_runs(tmp_path, monkeypatch):
