@@ -20,15 +20,19 @@ $(UV): | $(PY)
 	$(PY) -m pip install --quiet -c $(LOCK) uv
 
 # What `make demo` needs: the core (LunarLander, CartPole, any Gymnasium env). Redone when setup.cfg or
-# the lock changes. uv installs (pip would too: `pip install -c constraints.txt -e .`); measured on 2
-# cores for the core: uv 12 s cold, 2 s warm; pip 48 s either way (docs: install page).
+# the lock changes. uv installs (pip would too: `pip install -c constraints.txt -e .`).
+# --compile-bytecode writes every module's .pyc at install, as pip does by default: where the environment
+# sets PYTHONDONTWRITEBYTECODE (this project's machines and CI do), Python never writes them itself, and
+# every process compiled TensorFlow from source: its import took 10 s instead of 3.5 s, and `make test`,
+# which starts a process for every command-line test, 885 s instead of 685 s (benchmarks/install.py and
+# side-by-side suites beside a training, Intel Xeon, 2026-11-29; docs: speed notes).
 $(CORE): setup.cfg pyproject.toml $(LOCK) | $(UV)
-	$(UV) pip install --quiet --python $(PY) -c $(LOCK) -e .
+	$(UV) pip install --quiet --compile-bytecode --python $(PY) -c $(LOCK) -e .
 	touch $@
 
 # What `make test` needs: every extra (mario, minitaur, sweep, docs, export, test).
 $(ALL): setup.cfg pyproject.toml $(LOCK) | $(UV)
-	$(UV) pip install --quiet --python $(PY) -c $(LOCK) -e '.[all]'
+	$(UV) pip install --quiet --compile-bytecode --python $(PY) -c $(LOCK) -e '.[all]'
 	touch $@ $(CORE)
 
 # Install only (every extra), no training and no tests.
