@@ -158,10 +158,15 @@ def seed_runs(page: str, experiment: str) -> str:
             rows.append([str(meta["seed"]), evaluation_cell(ev, m), further, f"{meta['env_steps']:,}",
                          hours(meta["wall_seconds"]), f"{meta['env_steps'] / max(meta['wall_seconds'], 1e-9):,.0f}",
                          cpus_text(meta) or "not recorded", stop_text(meta, m)])
+        header = ["seed", "unseen seeds", "further unseen seeds", "env steps", "wall", "env steps/s", "CPU",
+                  "stopped by"]
+        stops = {row[-1] for row in rows}
+        ended = ""
+        if len(stops) == 1 and stops != {"–"}:  # one rule ended every run: said once, not in every row
+            rows, header, ended = [row[:-1] for row in rows], header[:-1], f"\n\nEvery run was stopped by {stops.pop()}."
         parts.append(f"**[{m.name}]({link(page, m.sweep.folder + '/report.md')})**, beside the shipped model's "
                      f"{score_text(m)}:\n\n"
-                     + table(["seed", "unseen seeds", "further unseen seeds", "env steps", "wall", "env steps/s",
-                              "CPU", "stopped by"], rows, "rrrrrrll")
+                     + table(header, rows, "rrrrrrll"[:len(header)]) + ended
                      + f"\n\nOver the {len(runs)} seeds: {over_seeds_bold(m, '[95% CI] ')}." + seeds_bar_text(m))
     if not parts:
         return "*Not kept in `results/sweeps/` yet: the runs' table appears here when they are.*"

@@ -249,6 +249,13 @@ def test_single_runs_over_seeds_are_kept_and_reported_as_a_sweep_of_their_level(
     rows = docgen_sweeps.seed_runs("docs/x.md", "mario_ppo")
     assert "| 0 | flag in 9 of 10 | flag in 27 of 30 (1000010..1000039) | 1,000 | 10 s | 100 | not recorded | – |" in rows
     assert "| 1 | flag in 10 of 10 | – |" in rows
+    for seed in range(3):  # one rule ended every run: said once below the table, not in every row
+        meta_path = kept / f"seed={seed}" / "model" / "meta.json"
+        meta_path.write_text(json.dumps({**json.loads(meta_path.read_text()), "stopped_by": "stop_success_share 0.9"}))
+    rows = docgen_sweeps.seed_runs("docs/x.md", "mario_ppo")
+    assert "| 0 | flag in 9 of 10 | flag in 27 of 30 (1000010..1000039) | 1,000 | 10 s | 100 | not recorded |\n" in rows
+    assert "stopped by" not in rows.split("Every run")[0] and ("Every run was stopped by the flag reached in 90% or "
+                                                               "more of the last 100") in rows
     monkeypatch.setattr(docgen, "shipped_models", lambda: [shipped])
     monkeypatch.setattr(docgen, "REPO", tmp_path)
     curves = docgen.region_curves("docs/experiments/mario_ppo.md", "mario_ppo")
