@@ -1,6 +1,8 @@
 """The README's "same recipe over seeds [95% CI]" figures are recomputed from the sweep results git keeps
 (`results/sweeps/NAME`, written by `main.py report SWEEP --keep`), so a figure cannot drift from its
 runs, and the runs cannot go missing from a clone."""
+import json
+
 import numpy as np
 import pytest
 
@@ -123,7 +125,9 @@ def test_a_kept_runs_model_plays_its_recorded_first_episode_again(run):
     from rlcore import machine
     from rlcore.evaluation import evaluate, evaluate_success
     from rlcore.policies import load_policy
+    from tests.cpu_support import skip_where_its_precision_cannot_run
 
+    skip_where_its_precision_cannot_run(json.loads((KEPT / run / "model" / "meta.json").read_text()))
     exp, meta, policy = load_policy(KEPT / run / "model")
     first = meta["evaluation"]["per_episode"][0]
     assert first["seed"] == exp.eval_seed_base

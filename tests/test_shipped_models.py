@@ -23,7 +23,7 @@ from rlcore.evaluation import evaluate, evaluate_success
 from rlcore.experiment import experiment_names, get_experiment
 from rlcore.policies import load_policy
 from rlcore.video import record_video
-from tests.cpu_support import BFLOAT16_BLOCKED
+from tests.cpu_support import skip_where_its_precision_cannot_run
 
 SHIPPED = Path(__file__).resolve().parents[1] / "saved_networks"
 Z_ONE_SIDED = 3.09  # the standard normal's 99.9th percentile: a 0.1 % chance of failing a model at its bar
@@ -114,9 +114,7 @@ def _clears_bar_live(exp, meta, policy, folder: str) -> None:
 
 @pytest.mark.parametrize("experiment, algo, folder", MODELS)
 def test_shipped_model_meets_its_bar(experiment, algo, folder):
-    precision = read_json(SHIPPED / experiment / folder / "meta.json")["config"].get("precision")
-    if precision == "bfloat16" and BFLOAT16_BLOCKED:
-        pytest.skip(BFLOAT16_BLOCKED)
+    skip_where_its_precision_cannot_run(read_json(SHIPPED / experiment / folder / "meta.json"))
     exp, meta, policy = load_policy(SHIPPED / experiment / folder, experiment, algo)
     bar = exp.bar(folder)
     # the recorded story: our own training command, seed, budget, time, an evaluation on unseen seeds
