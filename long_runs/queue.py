@@ -1,10 +1,8 @@
 #!/usr/bin/env python3
-"""Issue 49's trainings, one at a time and in order, each resumed where it stopped:
-
-1. the Minitaur SAC sweep over seeds 0-4 (``long_runs/sweeps/minitaur__sac``, started by hand: the README
-   beside this file), until every trial has finished;
-2. Mario 1-1 over seeds 0-2 with the recipe fixed before the first run (the same README), each run then
-   evaluated on 30 further unseen seeds; nothing once ``results/sweeps/mario_ppo__1-1`` is kept.
+"""Issue 63's trainings, one at a time and in order, each resumed where it stopped: every Mario level
+from 1-1 to 2-4 from one command (the ``flag`` preset, fixed on 2026-12-03 before the first of these
+runs), plus two lever runs that measure a cheaper recipe (``--epochs 4``) on 1-1 and on 2-1 against it.
+Each level's run is then evaluated on 30 further unseen seeds.
 
     .venv/bin/python long_runs/queue.py --dry-run     # the next command, from the folders' state
     setsid nohup .venv/bin/python long_runs/queue.py > /tmp/queue.log 2>&1 &
@@ -13,8 +11,11 @@ Each step is read from the folders when the step before it ends, so the queue ca
 again at any time. Stop it with SIGTERM or Ctrl-C to its process group (``kill -TERM -- -PGID``; the
 queue prints its PGID): the running training writes its checkpoint and exits, and the queue starts
 nothing more. A step that fails stops the queue with that step's exit status, and so does a step that
-ends well but leaves the folders as they were (it would run again forever). Keeping a finished sweep
-(``main.py report ... --keep``) and committing it are left to a person, who reads the result first.
+ends well but leaves the folders as they were (it would run again forever). Shipping a finished level
+(its model, card and GIF) is left to a person, who reads the result first.
+
+``--repo`` runs the commands from another checkout of this repository (a worktree at a fixed commit, so
+that code changed in this one cannot reach a training in progress) while the run folders stay here.
 """
 from __future__ import annotations
 
@@ -26,60 +27,58 @@ import subprocess
 import sys
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO))  # rlcore, from this checkout
-MINITAUR = "long_runs/sweeps/minitaur__sac"
-MARIO_KEPT = "results/sweeps/mario_ppo__1-1"
-MARIO_SEEDS = (0, 1, 2)
-# the recipe, fixed before the first run (issue 49): the default preset, a 0.9 flag share stops it
-MARIO_RECIPE = ["--world", "1", "--stage", "1", "--stop-success-share", "0.9", "--precision", "bfloat16"]
+HERE = Path(__file__).resolve().parents[1]
+# the recipe, fixed before the first run (issue 63): the flag preset; bfloat16 where the CPU has it
+RECIPE = ["--preset", "flag", "--seed", "0", "--precision", "bfloat16", "--final-eval-episodes", "30"]
 QUIET = ["--wandb", "offline", "--no-progress"]
+LEVELS = ("1-1", "1-2", "1-3", "1-4", "2-1", "2-2", "2-3", "2-4")
+# (folder name, level, what the run adds to the recipe), in the order they train
+RUNS = (("1-1", "1-1", []), ("1-1-epochs-4", "1-1", ["--epochs", "4"]),
+        ("2-1", "2-1", []), ("2-1-epochs-4", "2-1", ["--epochs", "4"]),
+        *((level, level, []) for level in LEVELS if level not in ("1-1", "2-1")))
 
 
-def mario_dir(seed: int) -> str:
-    return f"long_runs/mario_ppo/1-1-seed-{seed}"
+def run_dir(name: str) -> str:
+    return f"long_runs/mario_ppo/{name}"
 
 
-def next_command(repo: Path = REPO) -> list[str] | None:
-    """The next step's ``main.py`` arguments, from the state of the folders under ``repo``; None when the
-    queue has nothing left to run."""
-    from rlcore.sweep import Sweep, trial_name
+def train_command(name: str, level: str, extra: list[str]) -> list[str]:
+    world, stage = level.split("-")
+    return ["train", "mario_ppo", "ppo", *RECIPE, "--world", world, "--stage", stage, *extra,
+            "--run-dir", run_dir(name), *QUIET]
 
-    minitaur = repo / MINITAUR
-    if (minitaur / "sweep.json").is_file():
-        sweep = Sweep.load(minitaur)
-        done = _evaluated if sweep.final_eval_episodes != 0 else (lambda run: (run / "model" / "meta.json").is_file())
-        if not all(done(minitaur / trial_name(trial)) for trial in sweep.trials()):  # its resume evaluates a trained one
-            return ["sweep", "minitaur", "sac", "--dir", "long_runs/sweeps", "--name", "minitaur__sac", "--resume",
-                    "--num-cpus", "1"]
-    if (repo / MARIO_KEPT).exists():
-        return None
-    for seed in MARIO_SEEDS:
-        run = repo / mario_dir(seed)
+
+def next_command(folders: Path = HERE) -> list[str] | None:
+    """The next step's ``main.py`` arguments, from the state of the run folders under ``folders``; None
+    when the queue has nothing left to run."""
+    for name, level, extra in RUNS:
+        run = folders / run_dir(name)
         meta = run / "model" / "meta.json"
         if meta.is_file():
-            if not _evaluated(run):  # trained, but the process ended before its 10-episode evaluation
-                return ["evaluate", "mario_ppo", "ppo", "--model", mario_dir(seed), "--record"]
+            if not _evaluated(meta):  # trained, but the process ended before its final evaluation
+                return ["evaluate", "mario_ppo", "ppo", "--model", run_dir(name), "--episodes", "30", "--record"]
             if not json.loads(meta.read_text()).get("further_evaluations"):
-                return ["evaluate", "mario_ppo", "ppo", "--model", mario_dir(seed), "--episodes", "30",
+                return ["evaluate", "mario_ppo", "ppo", "--model", run_dir(name), "--episodes", "30",
                         "--record-further"]
             continue
         if (run / "checkpoint.npz").is_file():
-            return ["train", "mario_ppo", "ppo", "--resume", mario_dir(seed), *QUIET]
-        return ["train", "mario_ppo", "ppo", *MARIO_RECIPE, "--seed", str(seed), "--run-dir", mario_dir(seed), *QUIET]
+            return ["train", "mario_ppo", "ppo", "--resume", run_dir(name), *QUIET]
+        return train_command(name, level, extra)
     return None
 
 
-def _evaluated(run: Path) -> bool:
+def _evaluated(meta: Path) -> bool:
     """The run has trained and its evaluation on unseen seeds is in its model's meta.json."""
-    meta = run / "model" / "meta.json"
-    return meta.is_file() and bool(json.loads(meta.read_text()).get("evaluation"))
+    return bool(json.loads(meta.read_text()).get("evaluation"))
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--dry-run", action="store_true", help="print the next command and exit")
+    parser.add_argument("--repo", type=Path, default=HERE,
+                        help="the checkout whose main.py runs the commands (default: this one); the run "
+                             "folders are this checkout's either way")
     args = parser.parse_args(argv)
     if args.dry_run:
         command = next_command()
@@ -89,16 +88,23 @@ def main(argv: list[str] | None = None) -> int:
     # the training in the same process group gets the signal too, and checkpoints; the queue only stops
     previous = {number: signal.signal(number, lambda *_: stopping.append(True))
                 for number in (signal.SIGINT, signal.SIGTERM)}
+    repo = args.repo.resolve()
+    if repo != HERE:  # the other checkout writes its runs into this one's long_runs/mario_ppo
+        (repo / "long_runs").mkdir(exist_ok=True)
+        link = repo / "long_runs" / "mario_ppo"
+        (HERE / "long_runs" / "mario_ppo").mkdir(parents=True, exist_ok=True)
+        if not link.exists():
+            link.symlink_to(HERE / "long_runs" / "mario_ppo")
     try:
-        print(f"queue: pid {os.getpid()}, process group {os.getpgrp()}", flush=True)
+        print(f"queue: pid {os.getpid()}, process group {os.getpgrp()}, code from {repo}", flush=True)
         done = None
         while not stopping and (command := next_command()) is not None:
-            if command == done:  # it ended well and changed nothing: a trial that keeps failing, say
+            if command == done:  # it ended well and changed nothing: a run that keeps failing, say
                 print("queue: stopped: python main.py " + " ".join(command) + " ended with status 0 and left "
                       "the folders as they were; see its output above", flush=True)
                 return 1
             print("queue: python main.py " + " ".join(command), flush=True)
-            code = subprocess.call([sys.executable, "main.py", *command], cwd=REPO)
+            code = subprocess.call([sys.executable, "main.py", *command], cwd=repo)
             if code != 0:
                 print(f"queue: stopped, exit status {code}", flush=True)
                 return code

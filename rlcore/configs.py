@@ -162,6 +162,11 @@ class PPOConfig(RunBudget):
     clip: float = _h(0.2, "PPO clip range of the probability ratio",
                      Allowed(low=0, high=1, low_open=True, high_open=True))
     entropy_coef: float = _h(0.05, "entropy bonus weight (below 0: a penalty that sharpens pi)", FINITE)
+    entropy_halve_at: tuple[float, ...] = _h((), "halve the entropy weight the first time the success share "
+                                                 "(as the stop rule reads it) reaches each of these, e.g. "
+                                                 "0.1,0.3,0.5 (empty = never); --entropy-coef is the weight "
+                                                 "before any halving",
+                                             Allowed(low=0, high=1, low_open=True, empty_ok=True))
     value_coef: float = _h(1.0, "value loss weight (the article adds it unweighted)", NON_NEGATIVE)
     value_loss: str = _h("mse", "mse: the squared error (the article); huber: 0.5 e^2 within 1, |e| - 0.5 "
                          "beyond (uvipen's PyTorch Mario), so a few large errors cannot swamp the "

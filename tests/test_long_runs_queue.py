@@ -1,13 +1,11 @@
-"""long_runs/queue.py: issue 49's trainings one at a time, each step read from the folders' state; its
-Mario command is the recipe the docs give, and every command it gives parses."""
+"""long_runs/queue.py: issue 63's trainings one at a time, each step read from the folders' state; every
+level's command is the flag preset's recipe, and every command it gives parses."""
 import importlib.util
 import json
-import shlex
 import signal
 from pathlib import Path
 
 from rlcore.command_line import build_parser
-from rlcore.sweep import Sweep
 
 ROOT = Path(__file__).resolve().parents[1]
 spec = importlib.util.spec_from_file_location("long_runs_queue", ROOT / "long_runs" / "queue.py")
@@ -26,61 +24,39 @@ def _finish(folder: Path, **meta):
     (folder / "model" / "meta.json").write_text(json.dumps(meta))
 
 
-def test_the_queue_runs_the_minitaur_sweep_then_each_mario_seed_then_its_further_evaluation(tmp_path):
-    sweep = tmp_path / queue.MINITAUR
-    sweep.mkdir(parents=True)
-    Sweep("minitaur", "sac", "minitaur__sac", str(sweep), [0, 1]).save()
-    _finish(sweep / "seed=0", evaluation={"mean": 18.6})
+def test_the_queue_trains_each_run_in_order_resumes_it_then_evaluates_it_on_30_further_seeds(tmp_path):
     steps = [queue.next_command(tmp_path)]
-    assert steps[-1][:3] == ["sweep", "minitaur", "sac"] and "--resume" in steps[-1]
-    _finish(sweep / "seed=1")  # trained, not evaluated: the sweep's resume evaluates it
-    assert queue.next_command(tmp_path) == steps[-1]
-    _finish(sweep / "seed=1", evaluation={"mean": 20.8})  # every trial evaluated: on to Mario, kept or not
+    assert steps[-1] == queue.train_command("1-1", "1-1", [])
+    first = tmp_path / queue.run_dir("1-1")
+    first.mkdir(parents=True)
+    (first / "checkpoint.npz").write_bytes(b"")  # stopped at a checkpoint: the plain resume, nothing else
     steps.append(queue.next_command(tmp_path))
-    assert steps[-1][:3] == ["train", "mario_ppo", "ppo"] and steps[-1][steps[-1].index("--seed") + 1] == "0"
-    seed0 = tmp_path / queue.mario_dir(0)
-    seed0.mkdir(parents=True)
-    (seed0 / "checkpoint.npz").write_bytes(b"")  # stopped at a checkpoint: the plain resume, nothing else
-    steps.append(queue.next_command(tmp_path))
-    assert steps[-1] == ["train", "mario_ppo", "ppo", "--resume", queue.mario_dir(0), "--wandb", "offline",
+    assert steps[-1] == ["train", "mario_ppo", "ppo", "--resume", queue.run_dir("1-1"), "--wandb", "offline",
                          "--no-progress"]
-    _finish(seed0)  # trained, but ended before its 10-episode evaluation: that evaluation, recorded
+    _finish(first)  # trained, but ended before its evaluation: that evaluation, recorded
     steps.append(queue.next_command(tmp_path))
-    assert steps[-1] == ["evaluate", "mario_ppo", "ppo", "--model", queue.mario_dir(0), "--record"]
-    _finish(seed0, evaluation={"episodes": 10})
+    assert steps[-1] == ["evaluate", "mario_ppo", "ppo", "--model", queue.run_dir("1-1"), "--episodes", "30",
+                         "--record"]
+    _finish(first, evaluation={"episodes": 30})
     steps.append(queue.next_command(tmp_path))
     assert steps[-1][:2] == ["evaluate", "mario_ppo"] and "--record-further" in steps[-1]
-    _finish(seed0, evaluation={"episodes": 10}, further_evaluations=[{"episodes": 30}])
-    steps.append(queue.next_command(tmp_path))
-    assert steps[-1][steps[-1].index("--seed") + 1] == "1"
-    for seed in queue.MARIO_SEEDS:
-        _finish(tmp_path / queue.mario_dir(seed), evaluation={"episodes": 10}, further_evaluations=[{"episodes": 30}])
-    assert queue.next_command(tmp_path) is None
-    (tmp_path / queue.MARIO_KEPT).mkdir(parents=True)
+    _finish(first, evaluation={"episodes": 30}, further_evaluations=[{"episodes": 30}])
+    steps.append(queue.next_command(tmp_path))  # the lever run: the same recipe with 4 epochs
+    assert steps[-1] == queue.train_command("1-1-epochs-4", "1-1", ["--epochs", "4"])
+    for name, _, _ in queue.RUNS:
+        _finish(tmp_path / queue.run_dir(name), evaluation={"episodes": 30}, further_evaluations=[{"episodes": 30}])
     assert queue.next_command(tmp_path) is None
     for command in steps:
         _parses(command)
 
 
-def test_the_queues_mario_command_is_the_recipe_the_docs_give(tmp_path):
-    command = queue.next_command(tmp_path)  # nothing there yet: seed 0's first run
-    documented = (ROOT / "long_runs" / "README.md").read_text()
-    line = "python main.py train mario_ppo ppo --world 1 --stage 1 --seed S --stop-success-share 0.9 --precision bfloat16"
-    assert line in documented.replace("\\\n    ", "")
-    given = _parses(command)
-    expected = _parses(shlex.split(line.replace("S", "0"))[2:] + ["--run-dir", queue.mario_dir(0)] + queue.QUIET)
-    assert vars(given) == vars(expected)
-
-
-def test_a_sweep_with_a_grid_is_waited_for_by_its_trials_names(tmp_path):
-    sweep = tmp_path / queue.MINITAUR
-    sweep.mkdir(parents=True)
-    Sweep("minitaur", "sac", "minitaur__sac", str(sweep), [0], {"lr": [1e-3, 3e-4]}).save()
-    _finish(sweep / "seed=0", evaluation={"mean": 1.0})  # not a trial of this sweep: its trials are lr=...__seed=0
-    assert queue.next_command(tmp_path)[0] == "sweep"
-    for name in ("lr=0.001__seed=0", "lr=0.0003__seed=0"):
-        _finish(sweep / name, evaluation={"mean": 1.0})
-    assert queue.next_command(tmp_path)[0] == "train"
+def test_every_level_has_one_run_of_the_recipe_and_only_levers_add_to_it():
+    levels = [level for name, level, extra in queue.RUNS if not extra]
+    assert sorted(levels) == sorted(queue.LEVELS) == sorted(set(levels))
+    for name, level, extra in queue.RUNS:
+        args = _parses(queue.train_command(name, level, extra))
+        assert (args.preset, f"{args.hp_world}-{args.hp_stage}", args.final_eval_episodes) == ("flag", level, 30)
+        assert extra in ([], ["--epochs", "4"])
 
 
 def test_a_step_that_ends_well_but_changes_nothing_stops_the_queue(monkeypatch, capsys):

@@ -96,8 +96,10 @@ def build_cnn_actor_critic(obs_shape: tuple, n_actions: int, precision: str = "f
     return keras.Model(frames, [logits, value], name="actor_critic")
 
 
-def ppo_losses(logits, values, actions, logp_old, advantages, targets, cfg: PPOConfig):
-    """(total, policy, value, entropy, approx_kl, clip_fraction) of one minibatch."""
+def ppo_losses(logits, values, actions, logp_old, advantages, targets, cfg: PPOConfig, entropy_coef=None):
+    """(total, policy, value, entropy, approx_kl, clip_fraction) of one minibatch; ``entropy_coef`` (a
+    variable while --entropy-halve-at may change it) defaults to the config's."""
+    entropy_coef = cfg.entropy_coef if entropy_coef is None else entropy_coef
     logp_all = tf.nn.log_softmax(logits)
     logp = tf.gather(logp_all, actions, batch_dims=1)
     if cfg.normalize_advantage:
@@ -115,7 +117,7 @@ def ppo_losses(logits, values, actions, logp_old, advantages, targets, cfg: PPOC
         value_loss = tf.reduce_mean(tf.where(tf.abs(err) < 1.0, 0.5 * tf.square(err), tf.abs(err) - 0.5))
     else:
         value_loss = tf.reduce_mean(tf.square(err))
-    total = policy_loss + cfg.value_coef * value_loss - cfg.entropy_coef * entropy
+    total = policy_loss + cfg.value_coef * value_loss - entropy_coef * entropy
     log_ratio = logp - logp_old
     approx_kl = tf.reduce_mean(tf.exp(log_ratio) - 1.0 - log_ratio)
     clip_fraction = tf.reduce_mean(tf.cast(tf.abs(ratio - 1.0) > cfg.clip, tf.float32))
@@ -146,6 +148,8 @@ class PPOAgent:
         self.obs_dtype = obs_dtype(self.obs_shape)  # frames stay uint8 up to the model
         self.opt = keras.optimizers.Adam(cfg.lr)
         self.opt.build(self.model.trainable_variables)
+        # a variable, so --entropy-halve-at changes it without retracing the compiled update
+        self.entropy_coef = tf.Variable(cfg.entropy_coef, dtype=tf.float32, trainable=False)
         frames = tf.TensorSpec([None, *self.obs_shape], tf.as_dtype(self.obs_dtype))
         self._forward = tf.function(lambda obs: self.model(obs), input_signature=[frames])
         t, n = cfg.n_steps, cfg.num_envs
@@ -198,7 +202,7 @@ class PPOAgent:
             mb_obs, mb_act, mb_logp, mb_adv, mb_tgt = (tf.gather(x, idx) for x in flat)
             with tf.GradientTape() as tape:
                 logits, v = self.model(mb_obs, training=True)
-                losses = ppo_losses(logits, v[:, 0], mb_act, mb_logp, mb_adv, mb_tgt, cfg)
+                losses = ppo_losses(logits, v[:, 0], mb_act, mb_logp, mb_adv, mb_tgt, cfg, self.entropy_coef)
                 total = tf.debugging.check_numerics(losses[0], "PPO loss")
             too_far = losses[APPROX_KL] > kl_limit  # the policy moved too far from the one that acted: stop here
 
@@ -231,6 +235,10 @@ class PPOAgent:
     def set_learning_rate(self, lr: float) -> None:
         """Adam's rate for the next updates (a variable, so the compiled update is not retraced)."""
         self.opt.learning_rate.assign(lr)
+
+    def set_entropy_coef(self, weight: float) -> None:
+        """The entropy weight for the next updates (a variable, as the learning rate)."""
+        self.entropy_coef.assign(weight)
 
     # ------------------------------------------------------------ persistence
     def save(self, folder: str | Path) -> list[Path]:

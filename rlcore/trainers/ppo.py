@@ -20,7 +20,7 @@ from rlcore.cpu import bfloat16_note, cpu_flags
 from rlcore.errors import UserError
 from rlcore.trainers import checkpoints
 from rlcore.trainers.divergence import reported_divergence
-from rlcore.trainers.lr_halving import LearningRateHalving
+from rlcore.trainers.lr_halving import HalvingAtShares, LearningRateHalving
 from rlcore.trainers.session import TrainingSession
 from rlcore.trainers.spec import RunSpec
 from rlcore.trainers.rollout_log import RolloutLog
@@ -80,13 +80,15 @@ def train(spec: RunSpec) -> Path:
         book = session.book
         rollouts = int(state.get("rollouts", 0)) if state else 0
         lr = LearningRateHalving(cfg.lr, cfg.lr_halve_at, state)
-        agent.set_learning_rate(lr.rate())  # a resume comes back at the rate its halvings left
+        entropy = HalvingAtShares("entropy weight", cfg.entropy_coef, cfg.entropy_halve_at, state)
+        agent.set_learning_rate(lr.rate())  # a resume comes back at the values its halvings left
+        agent.set_entropy_coef(entropy.rate())
 
         env_kept = {}  # what the envs built up (Mario: the restart routes), read while the pool is open
 
         def checkpoint():
             checkpoints.save(session, agent, rng, env_arrays=env_kept, rollouts=rollouts, init_from=parent,
-                             **lr.state())
+                             **{**lr.state(), **entropy.state()})  # one key, the best share
 
         t, n = cfg.n_steps, cfg.num_envs
         buf = Rollout(t, n, obs_shape, agent.obs_dtype)
@@ -126,13 +128,13 @@ def train(spec: RunSpec) -> Path:
             seconds = {"collect_seconds": round(collected - started, 3),  # where a rollout's time goes
                        "update_seconds": round(time.perf_counter() - collected, 3)}
             session.log_rollout(rollouts, {**log.row(), **losses, "lr": lr.rate(),
-                                           "entropy_coef": cfg.entropy_coef, **seconds})
+                                           "entropy_coef": entropy.rate(), **seconds})
             line = log.line(rollouts, session.env_steps, book, cfg.window)
             tqdm.write(line + f" | loss {losses['loss']:.3f} entropy {losses['entropy']:.2f}")
-            halved = lr.observe(book.settled_success_share)
-            if halved:
-                agent.set_learning_rate(lr.rate())
-                tqdm.write(halved)
+            for halving, apply in ((lr, agent.set_learning_rate), (entropy, agent.set_entropy_coef)):
+                if halved := halving.observe(book.settled_success_share):
+                    apply(halving.rate())
+                    tqdm.write(halved)
             if rollouts % cfg.checkpoint_rollouts == 0:
                 env_kept = checkpoints.env_memory(envs, memory)
                 checkpoint()

@@ -77,3 +77,44 @@ def test_ppo_halves_adam_rate_as_the_share_rises_and_a_resume_keeps_it(tmp_path)
     np.testing.assert_allclose(resumed["entropy_coef"], first_weight + 0.02)
     with np.load(spec.run_dir / CHECKPOINT_FILE) as data:
         assert float(data["optimizer/adam/1"]) == pytest.approx(2.5e-4)
+
+
+def test_the_entropy_weight_halves_by_the_same_rule_and_the_update_uses_it(tmp_path):
+    """--entropy-halve-at: rollouts.csv's entropy weight follows the marks the best share passed, the
+    compiled update reads the agent's variable (no retrace), and a resume comes back at the halved weight."""
+    spec = toy.spec("ppo", tmp_path, entropy_coef=0.04, entropy_halve_at=(0.3, 0.6), lr_halve_at=(0.6,))
+    ppo_trainer.train(spec)
+    rollouts = pd.read_csv(spec.run_dir / "rollouts.csv")
+    metrics = pd.read_csv(spec.run_dir / "metrics.csv")
+    steps = spec.config.n_steps * spec.config.num_envs
+    best, weights, rates = 0.0, [], []
+    for r in rollouts["rollout"]:
+        weights.append(0.04 * 0.5 ** sum(best >= mark for mark in (0.3, 0.6)))
+        rates.append(1e-3 * 0.5 ** (best >= 0.6))
+        ended = metrics[metrics["env_steps"] <= r * steps]
+        if len(ended) >= spec.config.window:
+            best = max(best, ended["success_share"].iloc[-1])
+    np.testing.assert_allclose(rollouts["entropy_coef"], weights)
+    np.testing.assert_allclose(rollouts["lr"], rates)
+    assert rollouts["entropy_coef"].iloc[-1] == pytest.approx(0.01)  # both marks passed
+    before = len(rollouts)
+    spec.resume = True
+    spec.config = dataclasses.replace(spec.config, max_episodes=len(metrics) + 10, stop_success_share=0.0)
+    ppo_trainer.train(spec)
+    resumed = pd.read_csv(spec.run_dir / "rollouts.csv").iloc[before:]
+    assert len(resumed)
+    np.testing.assert_allclose(resumed["entropy_coef"], 0.01)
+
+
+def test_the_loss_reads_the_weight_it_is_given():
+    import tensorflow as tf
+
+    from rlcore.agents.ppo import ppo_losses
+
+    cfg = PPOConfig(entropy_coef=0.5)
+    logits = tf.constant([[1.0, 0.0], [0.0, 2.0]])
+    args = (logits, tf.constant([0.1, 0.2]), tf.constant([0, 1]), tf.constant([-0.5, -0.3]),
+            tf.constant([1.0, -1.0]), tf.constant([0.0, 0.5]), cfg)
+    total, _, _, entropy, _, _ = ppo_losses(*args)
+    halved = ppo_losses(*args, tf.constant(0.25))[0]
+    assert float(halved - total) == pytest.approx(0.25 * float(entropy), rel=1e-5)
