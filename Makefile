@@ -78,11 +78,11 @@ benchmark: $(ALL)
 docs docs-check: export NO_MKDOCS_2_WARNING = 1
 
 docs: $(ALL)
-	$(PY) -m rlcore.docgen
+	$(PY) -m tools.docgen
 	$(VENV)/bin/mkdocs build --strict --quiet
 
 docs-check: $(ALL)
-	$(PY) -m rlcore.docgen --check
+	$(PY) -m tools.docgen --check
 	$(VENV)/bin/mkdocs build --strict --quiet --site-dir build/site-check
 
 # The README's and the model cards' GIFs, from the shipped models, each on a stated evaluation seed

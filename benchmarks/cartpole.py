@@ -40,11 +40,11 @@ def bench_pool(seconds=3.0):
 
 
 def bench_train(algo: str, experiment: str, no_eval: bool = False):
-    import importlib
     import tempfile
 
-    from rlcore.experiment import get_experiment
-    from rlcore.trainers.spec import RunSpec
+    from rlcore.algorithms.registry import family
+    from rlcore.environments.registry import get_experiment
+    from rlcore.training.spec import RunSpec
 
     exp = get_experiment(experiment)
     cfg = exp.preset(algo, "default")
@@ -53,7 +53,7 @@ def bench_train(algo: str, experiment: str, no_eval: bool = False):
     spec = RunSpec(exp, algo, "default", cfg, 0, "off", Path(tempfile.mkdtemp(prefix="bench_")),
                    command="benchmark", progress=False)
     with contextlib.redirect_stdout(sys.stderr):  # stdout carries only the JSON lines
-        model_dir = importlib.import_module(f"rlcore.trainers.{exp.algo(algo).kind}").train(spec)
+        model_dir = family(exp.algo(algo).kind).train(spec)
     meta = json.loads((model_dir / "meta.json").read_text())
     emit(bench="train", experiment=experiment, algo=algo, preset="default", seed=0, periodic_eval=not no_eval,
          env_steps=meta["env_steps"], wall_seconds=meta["wall_seconds"],

@@ -30,7 +30,7 @@ def random_env_rate(make_env, seconds: float = 3.0) -> int:
 
 def pool_rate(make_env, num_envs: int, mode: str, n_actions: int, seconds: float) -> tuple[float, float]:
     """(startup seconds, agent steps per second) of an EnvPool of `num_envs` copies under random actions."""
-    from rlcore.vector import EnvPool
+    from rlcore.environments.vector import EnvPool
 
     rng = np.random.default_rng(0)
     started = time.perf_counter()

@@ -47,7 +47,7 @@ def _time(fn, n):
 def bench_dqn_costs():
     import tensorflow as tf
 
-    from rlcore.agents.dqn import DQNAgent
+    from rlcore.algorithms.dqn.agent import DQNAgent
     cfg = EXPERIMENT.preset("dqn", "default")
     agent = DQNAgent(8, 4, cfg)
     rng = np.random.default_rng(0)
@@ -70,11 +70,10 @@ def bench_dqn_costs():
 
 
 def bench_train_to_solved(algo: str, seed: int, max_seconds: float):
-    import importlib
-
-    from rlcore.trainers.session import TrainingSession
-    from rlcore.trainers.spec import RunSpec
-    from rlcore.trainers.stopping import Interrupted
+    from rlcore.algorithms.registry import family
+    from rlcore.training.session import TrainingSession
+    from rlcore.training.spec import RunSpec
+    from rlcore.training.stopping import Interrupted
 
     cfg = dataclasses.replace(EXPERIMENT.preset(algo, "default"), stop_score=EXPERIMENT.solved_score)
     run_dir = Path(tempfile.mkdtemp(prefix=f"bench_{algo}_"))
@@ -86,7 +85,7 @@ def bench_train_to_solved(algo: str, seed: int, max_seconds: float):
     start = time.perf_counter()
     try:
         with contextlib.redirect_stdout(sys.stderr):  # stdout carries only the JSON lines
-            model_dir = importlib.import_module(f"rlcore.trainers.{kind}").train(spec)
+            model_dir = family(kind).train(spec)
         meta = json.loads((model_dir / "meta.json").read_text())
     except Interrupted:
         meta = None

@@ -38,8 +38,8 @@ CFG = EXPERIMENT.preset("ppo", "default")
 
 
 def bench_emulator(seconds: float):
-    import gymnasium as gym
     import gym_super_mario_bros  # noqa: F401
+    import gymnasium as gym
 
     rate = random_env_rate(lambda: gym.make("SuperMarioBros-1-1-v0").unwrapped, seconds)
     emit(bench="emulator", env="SuperMarioBros-1-1-v0", frames_per_s=rate)
@@ -60,7 +60,7 @@ def bench_pool(seconds: float):
 
 
 def bench_agent(precision: str):
-    from rlcore.agents.ppo import PPOAgent
+    from rlcore.algorithms.ppo.agent import PPOAgent
 
     cfg = dataclasses.replace(CFG, precision=precision)
     agent = PPOAgent((84, 84, 4), 7, cfg)
@@ -86,8 +86,8 @@ def bench_agent(precision: str):
 
 
 def bench_train(rollouts: int, precision: str):
-    from rlcore.trainers import ppo
-    from rlcore.trainers.spec import RunSpec
+    from rlcore.algorithms.ppo import train as ppo
+    from rlcore.training.spec import RunSpec
 
     steps = rollouts * CFG.n_steps * CFG.num_envs
     cfg = dataclasses.replace(CFG, max_env_steps=steps, precision=precision)

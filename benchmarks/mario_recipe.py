@@ -54,8 +54,8 @@ def time_rollouts(cfg, rollouts: int, world: int, stage: int, precision: str) ->
     import pandas as pd
 
     from mario_ppo.experiment import EXPERIMENT
-    from rlcore.trainers import ppo
-    from rlcore.trainers.spec import RunSpec
+    from rlcore.algorithms.ppo import train as ppo
+    from rlcore.training.spec import RunSpec
 
     steps = rollouts * cfg.n_steps * cfg.num_envs
     cfg = dataclasses.replace(cfg, max_env_steps=steps, precision=precision, world=world, stage=stage,

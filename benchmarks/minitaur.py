@@ -67,7 +67,7 @@ def _time(fn, n):
 
 
 def bench_agent():
-    from rlcore.agents.sac import SACAgent
+    from rlcore.algorithms.sac.agent import SACAgent
 
     rng = np.random.default_rng(0)
     obs = rng.normal(size=(1, 28)).astype(np.float32)
@@ -84,8 +84,8 @@ def bench_agent():
 
 
 def bench_train(steps: int):
-    from rlcore.trainers import sac
-    from rlcore.trainers.spec import RunSpec
+    from rlcore.algorithms.sac import train as sac
+    from rlcore.training.spec import RunSpec
 
     cfg = dataclasses.replace(CFG, max_env_steps=steps, eval_every_steps=0, keep_best=False)
     spec = RunSpec(EXPERIMENT, "sac", "default", cfg, 0, "off", Path(tempfile.mkdtemp(prefix="bench_")),

@@ -28,7 +28,7 @@ sys.path.insert(0, str(ROOT))
 
 from common import emit  # noqa: E402
 
-from rlcore.cpu import cpu_description  # noqa: E402
+from rlcore.host.cpu import cpu_description  # noqa: E402
 
 
 def start(run_dir: Path, steps: int, learning_starts: int, threads: int, seed: int) -> subprocess.Popen:

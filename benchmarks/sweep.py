@@ -29,10 +29,10 @@ def main():
     parser.add_argument("--runs", type=int, default=4)
     parser.add_argument("--episodes", type=int, default=60)
     args = parser.parse_args()
-    from rlcore import experiment as registry
-    from rlcore.run import build_spec, run_training
-    from rlcore.sweep import Sweep
-    from rlcore.sweep_ray import run_sweep
+    from rlcore.environments import registry
+    from rlcore.sweeps.on_ray import run_sweep
+    from rlcore.sweeps.sweep import Sweep
+    from rlcore.training.run import build_spec, run_training
 
     registry.EXPERIMENT_MODULES["toy"] = "tests.toy"
     budget = {"max_episodes": args.episodes, "stop_score": 99.0}

@@ -10,8 +10,9 @@ from functools import partial
 
 import gymnasium as gym
 
-from rlcore.configs import A2CConfig, DQNConfig
-from rlcore.experiment import AlgoSpec, Bar, Experiment
+from rlcore.algorithms.a2c.config import A2CConfig
+from rlcore.algorithms.dqn.config import DQNConfig
+from rlcore.environments.experiment import AlgoSpec, Bar, Experiment
 
 
 def make_env(render_mode: str | None = None, max_episode_steps: int | None = None,

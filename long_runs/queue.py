@@ -14,8 +14,9 @@ nothing more. A step that fails stops the queue with that step's exit status, an
 ends well but leaves the folders as they were (it would run again forever). Shipping a finished level
 (its model, card and GIF) is left to a person, who reads the result first.
 
-``--repo`` runs the commands from another checkout of this repository (a worktree at a fixed commit, so
-that code changed in this one cannot reach a training in progress) while the run folders stay here.
+A training run from a worktree at a fixed commit (``git worktree add --detach ../runner``, its
+``long_runs/mario_ppo`` a symlink to this one's) cannot be reached by code changed here meanwhile; its
+run folders are this checkout's, committed by ``make save-long-runs``.
 """
 from __future__ import annotations
 
@@ -76,9 +77,6 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--dry-run", action="store_true", help="print the next command and exit")
-    parser.add_argument("--repo", type=Path, default=HERE,
-                        help="the checkout whose main.py runs the commands (default: this one); the run "
-                             "folders are this checkout's either way")
     args = parser.parse_args(argv)
     if args.dry_run:
         command = next_command()
@@ -88,15 +86,8 @@ def main(argv: list[str] | None = None) -> int:
     # the training in the same process group gets the signal too, and checkpoints; the queue only stops
     previous = {number: signal.signal(number, lambda *_: stopping.append(True))
                 for number in (signal.SIGINT, signal.SIGTERM)}
-    repo = args.repo.resolve()
-    if repo != HERE:  # the other checkout writes its runs into this one's long_runs/mario_ppo
-        (repo / "long_runs").mkdir(exist_ok=True)
-        link = repo / "long_runs" / "mario_ppo"
-        (HERE / "long_runs" / "mario_ppo").mkdir(parents=True, exist_ok=True)
-        if not link.exists():
-            link.symlink_to(HERE / "long_runs" / "mario_ppo")
     try:
-        print(f"queue: pid {os.getpid()}, process group {os.getpgrp()}, code from {repo}", flush=True)
+        print(f"queue: pid {os.getpid()}, process group {os.getpgrp()}", flush=True)
         done = None
         while not stopping and (command := next_command()) is not None:
             if command == done:  # it ended well and changed nothing: a run that keeps failing, say
@@ -104,7 +95,7 @@ def main(argv: list[str] | None = None) -> int:
                       "the folders as they were; see its output above", flush=True)
                 return 1
             print("queue: python main.py " + " ".join(command), flush=True)
-            code = subprocess.call([sys.executable, "main.py", *command], cwd=repo)
+            code = subprocess.call([sys.executable, "main.py", *command], cwd=HERE)
             if code != 0:
                 print(f"queue: stopped, exit status {code}", flush=True)
                 return code

@@ -9,8 +9,9 @@ import dataclasses
 
 import gymnasium as gym
 
-from rlcore.configs import A2CConfig, DQNConfig
-from rlcore.experiment import AlgoSpec, Bar, Experiment
+from rlcore.algorithms.a2c.config import A2CConfig
+from rlcore.algorithms.dqn.config import DQNConfig
+from rlcore.environments.experiment import AlgoSpec, Bar, Experiment
 
 ENV_ID = "LunarLander-v3"
 SOLVED_SCORE = 200.0

@@ -184,7 +184,7 @@ def make_env(render_mode: str | None = None, max_episode_steps: int | None = Non
     of that spacing, the point drawn by ``restart_weights``, each point's state kept by ``restart_keep``,
     the x stepped back by ``restart_back_step`` once ``restart_back_share`` of the restarts get past
     ``restart_goal_x`` (training only, :mod:`mario_ppo.restarts`)."""
-    from rlcore.extras import require
+    from rlcore.host.extras import require
 
     for module in ("cv2", "nes_py", "gym_super_mario_bros"):  # the mario extra, or one line
         require(module, "Mario")

@@ -14,10 +14,10 @@ from mario_ppo.env import ACTION_SETS, FRAME_STACKS, make_env
 from mario_ppo.episode_ends import StallLimit
 from mario_ppo.levels import STAGE, WORLD
 from mario_ppo.restarts import KEEPS, WEIGHTS
-from rlcore.allowed import OFF_OR_COUNT, Allowed, choices, flag, require
-from rlcore import extras
-from rlcore.configs import PPOConfig
-from rlcore.experiment import AlgoSpec, Bar, Curriculum, Experiment, Goal, SeedsBar, ShippedBy
+from rlcore.algorithms.ppo.config import PPOConfig
+from rlcore.environments.experiment import AlgoSpec, Bar, Curriculum, Experiment, Goal, SeedsBar, ShippedBy
+from rlcore.host import extras
+from rlcore.hyperparams.allowed import OFF_OR_COUNT, Allowed, choices, flag, require
 
 
 @dataclass(frozen=True)

@@ -30,7 +30,7 @@ import numpy as np
 
 from minitaur.motor import OBSERVED_TORQUE_LIMIT, SPEED_LIMIT
 from minitaur.robot import NUM_MOTORS, Minitaur, leg_model_to_motor_angles
-from rlcore.quiet import filtered_stderr
+from rlcore.host.quiet import filtered_stderr
 
 ENV_ID = "deeprl/Minitaur-v0"
 CONTROL_STEP = 0.01
@@ -58,7 +58,7 @@ class MinitaurEnv(gym.Env):
         if render_mode not in (None, "rgb_array"):
             raise ValueError(f"render_mode {render_mode!r} is not supported; use 'rgb_array' or None")
         # pybullet prints its build time on import and "argv[0]=" on every connect
-        from rlcore.extras import require
+        from rlcore.host.extras import require
 
         with filtered_stderr():
             pybullet = require("pybullet", "Minitaur")  # the minitaur extra, or one line saying so

@@ -4,9 +4,9 @@ from __future__ import annotations
 import dataclasses
 
 from minitaur.env import make_env
-from rlcore import extras
-from rlcore.configs import SACConfig
-from rlcore.experiment import AlgoSpec, Bar, Experiment, SeedsBar
+from rlcore.algorithms.sac.config import SACConfig
+from rlcore.environments.experiment import AlgoSpec, Bar, Experiment, SeedsBar
+from rlcore.host import extras
 
 # Article 004 (TF-Agents' SAC Minitaur colab): 256-256 actor and critics, Adam 3e-4 for all three,
 # tau 0.005 every step, gamma 0.99, batch 256, replay 1M, 10k initial steps, one env step per

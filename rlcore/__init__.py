@@ -1,10 +1,12 @@
-"""Shared core of the package: agents, replay, env pool, tracking, checkpoints, video.
+"""What every experiment shares, one subpackage per concern, from the bottom up: ``files``, ``host``,
+``hyperparams``, ``environments``, ``networks``, ``algorithms`` (a folder per family and the one registry of
+families), ``training`` (one run), ``models`` (saved models), ``runs`` (reading a run back), ``sweeps``,
+``api`` and ``cli``; each ``__init__`` says what it holds and what it may import (docs/developer/layout.md).
 
-Nothing in here knows an environment by name; experiment packages (``lunar_lander`` ...)
-register themselves in :mod:`rlcore.experiment`, and any Gymnasium id is one too
-(:mod:`rlcore.gym_experiment`).
+Nothing in here knows an environment by name; experiment packages (``lunar_lander`` ...) are found by
+:mod:`rlcore.environments.registry`, and any Gymnasium id is one too (:mod:`rlcore.environments.gym_experiment`).
 
-The Python API is :mod:`rlcore.api` (a module of its own: ``rlcore.export`` is the export code)::
+The Python API is :mod:`rlcore.api`::
 
     from rlcore import api
     run = api.train("CartPole-v1", "ppo", steps=50_000)

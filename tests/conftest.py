@@ -24,7 +24,7 @@ def registry_as_it_was():
     and keeps it (a sweep trial run in-process registers what its driver hands it) would change what a
     later test on the same worker sees, and which one that is depends on how the files fall to workers
     (seen: `test_every_experiment_evaluates_above_the_training_seeds` met the toy's seeds, 2026-11-27)."""
-    from rlcore import experiment as registry
+    from rlcore.environments import registry
 
     before = dict(registry.EXPERIMENT_MODULES)
     yield
@@ -35,9 +35,9 @@ def registry_as_it_was():
 @pytest.fixture
 def sac_without_xla(monkeypatch):
     """SAC agents built without XLA: ~2 s less CPU for each of the many short-lived agents of the tests
-    of a trainer's bookkeeping (resume, counters, logging). tests/rlcore/test_sac.py and the end-to-end
+    of a trainer's bookkeeping (resume, counters, logging). tests/rlcore/algorithms/test_sac.py and the end-to-end
     Minitaur run keep the compiled update that training uses."""
-    from rlcore.agents import sac
+    from rlcore.algorithms.sac import agent as sac
 
     monkeypatch.setattr(sac, "XLA", False)
 
@@ -45,7 +45,7 @@ def sac_without_xla(monkeypatch):
 @pytest.fixture
 def toy_experiments(monkeypatch):
     """The toy experiments of tests/toy*.py in the registry, so model folders of toy runs load."""
-    from rlcore import experiment as registry
+    from rlcore.environments import registry
 
     for name in ("toy", "toy_image", "toy_reach"):
         monkeypatch.setitem(registry.EXPERIMENT_MODULES, name, f"tests.{name}")

@@ -3,7 +3,7 @@ below AVX-512 on an AVX-512 CPU (``ONEDNN_MAX_CPU_ISA=AVX2 make test``, the deve
 the float32 kernels of an older CPU), so the tests that build one skip there, saying why."""
 import pytest
 
-from rlcore.cpu import bfloat16_refusal, cpu_flags
+from rlcore.host.cpu import bfloat16_refusal, cpu_flags
 
 BFLOAT16_BLOCKED = bfloat16_refusal("bfloat16", cpu_flags())
 needs_bfloat16 = pytest.mark.skipif(BFLOAT16_BLOCKED is not None, reason=BFLOAT16_BLOCKED or "")

@@ -1,7 +1,6 @@
 """The Python API end to end (api.train/resume/load/evaluate/render/export) and the notebook docs/api.ipynb,
 executed as a user would run it (nbclient, a real Jupyter kernel)."""
 import json
-import os
 from pathlib import Path
 
 import numpy as np
@@ -72,8 +71,8 @@ def test_load_mistakes_are_user_errors(model, message):
 ])
 def test_train_checks_its_arguments_as_the_command_line_does_before_any_folder_exists(tmp_path, kwargs, message,
                                                                                     capsys):
-    from rlcore.allowed import check_whole
-    from rlcore.command_line import RUN_SEEDS
+    from rlcore.cli.parser import RUN_SEEDS
+    from rlcore.hyperparams.allowed import check_whole
 
     check_whole("seed", np.int64(3), RUN_SEEDS)  # numpy's integers are whole numbers too
     with pytest.raises(UserError, match=message):
@@ -158,7 +157,7 @@ def test_resume_goes_on_from_the_checkpoint_records_the_call_and_what_it_changed
 def test_a_resume_keeps_the_runs_final_evaluation_and_wandb_mode_unless_given(tmp_path):
     """A run started with final_eval_episodes=2 and wandb off is evaluated on 2 episodes after a resume that
     does not say (not the experiment's 100) and makes no wandb folder; given again, they change."""
-    from rlcore.checkpoint import read_checkpoint_state
+    from rlcore.files.checkpoint import read_checkpoint_state
 
     first = api.train("cartpole", "dqn", run_dir=tmp_path / "run", episodes=2, final_eval_episodes=2, progress=False)
     state = read_checkpoint_state(first.run_dir / "checkpoint.npz")
@@ -171,7 +170,7 @@ def test_a_resume_keeps_the_runs_final_evaluation_and_wandb_mode_unless_given(tm
 
 def test_a_run_in_progress_loads_from_its_checkpoint(tmp_path):
     """A run folder with a checkpoint and no model yet (stopped, or still running): its last checkpoint."""
-    from rlcore.run import build_spec, run_training
+    from rlcore.training.run import build_spec, run_training
 
     spec = build_spec("cartpole", "dqn", overrides={"max_episodes": 2, "checkpoint_every": 1},
                       run_dir=tmp_path / "run", wandb_mode="off", progress=False, command="pytest")

@@ -9,9 +9,8 @@ from pathlib import Path
 
 import pytest
 
-import main
-from rlcore.experiment import experiment_names, get_experiment
-from rlcore.seeding import MAX_EVAL_EPISODES, MAX_RUN_SEED, TRAINING_SEED_SPAN, training_env_seed
+from rlcore.environments.registry import experiment_names, get_experiment
+from rlcore.environments.seeding import MAX_EVAL_EPISODES, MAX_RUN_SEED, TRAINING_SEED_SPAN, training_env_seed
 from tests.test_cli import ROOT, run
 
 BAD_VALUES = [
@@ -227,7 +226,7 @@ def test_hyperparameters_before_the_names_are_read_as_hyperparameters(capsys):
 
 def test_every_experiment_evaluates_above_the_training_seeds():
     """Training env seeds stay below TRAINING_SEED_SPAN (the seeds trainers really hand their envs:
-    tests/rlcore/test_training.py); every evaluation and selection seed is above it."""
+    tests/rlcore/training/test_training.py); every evaluation and selection seed is above it."""
     lowest = min(min(get_experiment(n).eval_seed_base, get_experiment(n).selection_seed_base)
                  for n in experiment_names())
     assert lowest >= TRAINING_SEED_SPAN
@@ -245,7 +244,7 @@ def test_seed_zero_keeps_the_env_seeds_of_the_shipped_runs():
 def test_no_two_run_seeds_share_a_training_env_seed():
     """Every run seed's block, over every index a run can reach, is its own and below the evaluation
     seeds (before, --seed 1000 repeated --seed 0, and seed 1 met seed 0's seeds after 1,000 episodes)."""
-    from rlcore.seeding import seed_block
+    from rlcore.environments.seeding import seed_block
 
     seen = set()
     for run_seed in range(MAX_RUN_SEED + 1):
@@ -313,7 +312,7 @@ def test_the_console_script_finds_shipped_models_from_elsewhere(tmp_path):
 def test_wandb_charts_every_table_against_env_steps(tmp_path, monkeypatch):
     import wandb.sdk.wandb_run as wandb_run
 
-    from rlcore.tracking import Tracker, wandb_row
+    from rlcore.training.tracking import Tracker, wandb_row
 
     defined = []
     original = wandb_run.Run.define_metric
@@ -335,7 +334,7 @@ def test_wandb_charts_every_table_against_env_steps(tmp_path, monkeypatch):
 
 
 def test_publish_replaces_the_shipped_folder_whole(tmp_path):
-    from rlcore.shipping import publish
+    from rlcore.models.shipping import publish
 
     model = tmp_path / "run" / "model"
     model.mkdir(parents=True)
@@ -391,8 +390,8 @@ def test_publish_refuses_a_model_that_misses_the_bar_of_the_one_it_would_replace
 
 
 def test_publish_refusal_reads_the_bar_of_the_folder_it_would_replace():
-    from rlcore.experiment import get_experiment
-    from rlcore.shipping import publish_refusal
+    from rlcore.environments.registry import get_experiment
+    from rlcore.models.shipping import publish_refusal
 
     lander, mario = get_experiment("lunar_lander"), get_experiment("mario_ppo")
     assert publish_refusal(lander, Path("saved/lunar_lander/dqn"), {"evaluation": {"mean": 231.0, "episodes": 100}}) is None
@@ -409,8 +408,8 @@ def test_publish_refusal_reads_the_bar_of_the_folder_it_would_replace():
 def test_a_folder_that_takes_no_new_files_is_said_so_not_missing():
     """/proc is there, but a file cannot be made in it: the OS says "No such file or directory", which read as
     if the folder were missing (a new user's `render ... --out /proc/x.mp4`)."""
-    from rlcore.atomic import writable_folder
     from rlcore.errors import UserError
+    from rlcore.files.atomic import writable_folder
 
     if not Path("/proc").is_dir():
         pytest.skip("no /proc here")

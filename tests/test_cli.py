@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import main
-from rlcore import experiment as registry
+from rlcore.environments import registry
 from tests import toy
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -36,8 +36,8 @@ def status_lines(capsys, run_dir, *options) -> list[str]:
 @pytest.fixture
 def dqn_model_dir(tmp_path):
     """An untrained LunarLander DQN model folder, written as training writes one."""
-    from rlcore.agents.dqn import DQNAgent
-    from rlcore.configs import DQNConfig
+    from rlcore.algorithms.dqn.agent import DQNAgent
+    from rlcore.algorithms.dqn.config import DQNConfig
 
     folder = tmp_path / "model"
     DQNAgent(8, 4, DQNConfig()).save(folder)
@@ -87,8 +87,8 @@ def test_bad_input_is_one_line_and_exit_2(capsys, argv, message):
 
 def test_a_model_of_another_environment_is_refused(capsys, tmp_path):
     """A Minitaur SAC actor (28 inputs) in a folder claiming to be LunarLander A2C."""
-    from rlcore.agents.sac import build_actor
-    from rlcore.models import save_keras_model
+    from rlcore.algorithms.sac.agent import build_actor
+    from rlcore.networks.saving import save_keras_model
 
     save_keras_model(build_actor(28, 8, (8,)), tmp_path / "actor.h5")
     (tmp_path / "meta.json").write_text(json.dumps({"experiment": "lunar_lander", "algo": "a2c"}))
@@ -109,8 +109,8 @@ def test_model_of_another_algorithm(capsys, dqn_model_dir):
 
 
 def test_model_with_the_wrong_shape(capsys, dqn_model_dir):
-    from rlcore.agents.dqn import DQNAgent
-    from rlcore.configs import DQNConfig
+    from rlcore.algorithms.dqn.agent import DQNAgent
+    from rlcore.algorithms.dqn.config import DQNConfig
 
     DQNAgent(4, 2, DQNConfig()).save(dqn_model_dir)  # a CartPole-shaped net in a LunarLander folder
     code, _, err = run(capsys, "evaluate", "lunar_lander", "dqn", "--model", str(dqn_model_dir))
@@ -147,7 +147,7 @@ def test_ctrl_c_mid_render_keeps_the_earlier_video_whole(capsys, dqn_model_dir, 
 
 
 def test_resume_with_a_checkpoint_of_another_algorithm(capsys, tmp_path, monkeypatch):
-    from rlcore.trainers import dqn as dqn_trainer
+    from rlcore.algorithms.dqn import train as dqn_trainer
 
     monkeypatch.setitem(registry.EXPERIMENT_MODULES, "toy", "tests.toy")
     spec = toy.spec("dqn", tmp_path, max_episodes=2, stop_score=99.0)
@@ -187,8 +187,8 @@ def test_list_and_help(capsys):
 
 def test_list_writes_each_shipped_score_as_the_readme_does(capsys):
     """`list` and the README's results table read the same meta.json: the same words and digits."""
-    from rlcore.docgen_words import score_text
-    from rlcore.docgen_data import shipped_models
+    from tools.docgen.data import shipped_models
+    from tools.docgen.words import score_text
 
     code, out, _ = run(capsys, "list")
     readme = (Path(main.__file__).parent / "README.md").read_text()
@@ -202,7 +202,7 @@ def test_list_writes_each_shipped_score_as_the_readme_does(capsys):
 
 
 def test_score_words_give_two_decimals_below_100_and_a_castles_axe():
-    from rlcore.score_words import score_words
+    from rlcore.runs.score_words import score_words
 
     assert score_words({"mean": 20.4512, "std": 3.987}, "minitaur", "sac") == "20.45 ± 3.99"
     assert score_words({"mean": 270.71, "std": 21.44}, "lunar_lander", "dqn", "+-") == "270.7 +- 21.4"
@@ -212,9 +212,9 @@ def test_score_words_give_two_decimals_below_100_and_a_castles_axe():
 
 def test_the_evaluate_line_names_a_levels_success_from_the_models_meta():
     """`evaluate` on a castle says axe, as the README does: the level comes from the model's meta.json."""
-    from rlcore.experiment import get_experiment
-    from rlcore.score_words import success_word
-    from rlcore.shipping import model_name
+    from rlcore.environments.registry import get_experiment
+    from rlcore.models.shipping import model_name
+    from rlcore.runs.score_words import success_word
 
     mario = get_experiment("mario_ppo")
     assert model_name(mario, {"config": {"world": 2, "stage": 4}}) == "2-4"
@@ -271,7 +271,7 @@ def test_ctrl_c_saves_a_checkpoint_and_resume_continues(tmp_path, signal_name, c
 
 def test_every_algorithm_builds_its_train_parser(capsys):
     """Hyperparameter flags must not collide with the CLI's own flags, for any preset."""
-    from rlcore.experiment import experiment_names, get_experiment
+    from rlcore.environments.registry import experiment_names, get_experiment
 
     for name in experiment_names():
         for algo, spec in get_experiment(name).algos.items():
@@ -294,7 +294,7 @@ def test_shipped_models_are_found_from_any_working_directory(capsys, tmp_path, m
     monkeypatch.chdir(tmp_path)
     code, out, _ = run(capsys, "evaluate", "lunar_lander", "dqn", "--episodes", "2")
     assert code == 0 and "greedy return" in out
-    from rlcore.experiment import get_experiment
+    from rlcore.environments.registry import get_experiment
     lander = get_experiment("lunar_lander")  # the task's number and ours, each named
     assert f"; the task's solved score {lander.solved_score:g}: " in out
     assert f"; the shipped model's bar ({lander.bar('dqn').describe()}): " in out
@@ -314,8 +314,8 @@ def test_evaluate_a_mario_level_by_world_and_stage(capsys, tmp_path, monkeypatch
 def test_evaluate_and_render_a_run_in_progress_and_a_finished_run_folder(capsys, tmp_path, monkeypatch):
     """--model RUN_DIR: a run without a model plays its last checkpoint (and --record is refused);
     a finished run's folder plays its model/."""
-    from tests.rlcore.test_resume import _interrupt_after
-    from rlcore.trainers import dqn as dqn_trainer
+    from rlcore.algorithms.dqn import train as dqn_trainer
+    from tests.rlcore.training.test_resume import _interrupt_after
 
     monkeypatch.setitem(registry.EXPERIMENT_MODULES, "toy", "tests.toy")
     spec = toy.spec("dqn", tmp_path, max_episodes=30, stop_score=99.0)
@@ -337,7 +337,7 @@ def test_evaluate_and_render_a_run_in_progress_and_a_finished_run_folder(capsys,
 def test_a_further_evaluation_plays_the_next_unseen_seeds_and_keeps_the_evaluation(capsys, tmp_path, monkeypatch):
     """evaluate --record-further: a held-out check added beside the model's evaluation, on seeds no
     recorded evaluation played; overlapping or seen seeds, both flags, a run in progress: one line each."""
-    from rlcore.trainers import dqn as dqn_trainer
+    from rlcore.algorithms.dqn import train as dqn_trainer
 
     monkeypatch.setitem(registry.EXPERIMENT_MODULES, "toy", "tests.toy")
     spec = toy.spec("dqn", tmp_path, max_episodes=20, stop_score=99.0)
@@ -384,8 +384,8 @@ def test_the_flags_that_choose_a_shipped_model_come_from_the_registry(capsys, mo
     import dataclasses
     import types
 
-    from rlcore.command_line import shipped_by_options
-    from rlcore.experiment import ShippedBy
+    from rlcore.cli.parser import shipped_by_options
+    from rlcore.environments.experiment import ShippedBy
 
     module = types.ModuleType("tests.toy_sized")
     module.EXPERIMENT = dataclasses.replace(toy.EXPERIMENT, name="toy_sized",
@@ -412,7 +412,7 @@ def test_the_flags_that_choose_a_shipped_model_come_from_the_registry(capsys, mo
 
 
 def test_a_shipped_by_folder_fills_the_values_not_given_from_its_default():
-    from rlcore.experiment import ShippedBy
+    from rlcore.environments.experiment import ShippedBy
 
     by = ShippedBy(fields=("world", "stage"), default="1-1", noun="level")
     assert by.default_values() == {"world": "1", "stage": "1"}
@@ -426,7 +426,7 @@ def test_the_installed_script_is_deeprl_and_says_its_version():
 
     dist = distribution("deeprl-tf2")
     scripts = {e.name: e.value for e in dist.entry_points if e.group == "console_scripts"}
-    assert scripts == {"deeprl": "rlcore.cli:main"}
+    assert scripts == {"deeprl": "rlcore.cli.main:main"}
     script = Path(sys.executable).parent / "deeprl"
     done = subprocess.run([str(script), "--version"], capture_output=True, text=True, timeout=60)
     assert done.returncode == 0 and done.stdout.strip() == f"deeprl {dist.version}"

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from rlcore.command_line import build_parser
+from rlcore.cli.parser import build_parser
 
 REPO = Path(__file__).resolve().parents[1]
 DOC_FILES = [REPO / "README.md"] + sorted((REPO / "docs").rglob("*.md"))
@@ -25,13 +25,13 @@ SCHEMATIC = {"python main.py ...", "python main.py COMMAND ...",
 
 
 def test_generated_docs_have_not_drifted():
-    result = subprocess.run([sys.executable, "-m", "rlcore.docgen", "--check"], cwd=REPO,
+    result = subprocess.run([sys.executable, "-m", "tools.docgen", "--check"], cwd=REPO,
                             capture_output=True, text=True, timeout=120)
     assert result.returncode == 0, result.stdout + result.stderr
 
 
 def test_docgen_imports_no_tensorflow():
-    code = "import sys, rlcore.docgen as d; d.generate(); print('tensorflow' in sys.modules)"
+    code = "import sys, tools.docgen.main as d; d.generate(); print('tensorflow' in sys.modules)"
     result = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, timeout=120)
     assert result.stdout.strip() == "False", result.stdout + result.stderr
 
@@ -104,11 +104,8 @@ def test_the_layout_page_names_every_module():
     modules = [path for name in packages for path in sorted((REPO / name).rglob("*.py")) if path.name != "__init__.py"]
     assert len(modules) > 60
     def named(path: Path) -> bool:
-        """The file's name on the page, not inside another name (status.py in sweep_status.py); a module of
-        rlcore/agents/ as agents/NAME (trainers/ has modules of the same names, listed by name alone)."""
+        """The file's name on the page, not inside another name (status.py in sweep_status.py)."""
         name = re.escape(path.name)
-        if path.parent.name == "agents":
-            return re.search(rf"agents/{name}", layout) is not None
         return re.search(rf"(?<![\w/]){name}|{path.parent.name}/{name}", layout) is not None
 
     missing = [str(path.relative_to(REPO)) for path in modules if not named(path)]
@@ -123,7 +120,7 @@ def test_no_page_shows_a_doubled_percent_sign():
 
 
 def test_the_reproducibility_page_names_every_setting_a_record_replays_on():
-    from rlcore import machine
+    from rlcore.host import machine
 
     page = (REPO / "docs" / "guide" / "reproducibility.md").read_text()
     for name in ("TF_ENABLE_ONEDNN_OPTS", *machine.NUMERIC_VARIABLES):
@@ -154,7 +151,7 @@ def test_every_relative_link_holds_in_the_repository():
 
 def test_the_site_hook_points_repository_links_at_the_mounted_copies():
     pytest.importorskip("mkdocs", reason="mkdocs is not installed (the docs extra: pip install -e '.[docs]')")
-    from rlcore.docgen_hooks import site_links
+    from tools.docgen.hooks import site_links
 
     page = "docs/models/mario_ppo_1-1.md"
     text = ("![plot](../../saved_networks/mario_ppo/1-1/a.png) [report](../../results/sweeps/x/report.md#iqm) "

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rlcore.checkpoint import read_checkpoint_state
+from rlcore.files.checkpoint import read_checkpoint_state
 from tests.test_cli import run  # the command line in this process
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -61,7 +61,7 @@ def test_mario_ppo_through_the_process_pool_survives_kill_9_and_resumes(tmp_path
     assert steps[-1] == budget and np.all(np.diff(steps) == 128)
     final = read_checkpoint_state(run_dir / "checkpoint.npz")
     assert final["rollouts"] == state["rollouts"] + 2
-    from rlcore.cpu import cpu_description
+    from rlcore.host.cpu import cpu_description
 
     assert final["command_starts"][-1] == {"env_steps": state["env_steps"], "episodes": len(state["returns"]),
                                            "wall_seconds": round(float(state["wall_seconds"]), 1),
@@ -75,7 +75,7 @@ def test_mario_ppo_through_the_process_pool_survives_kill_9_and_resumes(tmp_path
 def test_minitaur_sac_on_pybullet_learns_past_learning_starts_and_resumes(tmp_path, capsys):
     run_dir = tmp_path / "minitaur"
     # small, and one gradient step per compiled call: the preset's four took 31 s of CPU for the test against
-    # 16 s, most of it compiling them in each of the two runs (stacked updates: tests/rlcore/test_sac.py)
+    # 16 s, most of it compiling them in each of the two runs (stacked updates: tests/rlcore/algorithms/test_sac.py)
     small = ["--max-episode-steps", "50", "--learning-starts", "100", "--batch-size", "32", "--buffer-size", "5000",
              "--updates-per-call", "1", "--checkpoint-every", "1"]
     assert run(capsys, "train", "minitaur", "sac", *small, "--steps", "200", "--run-dir", str(run_dir), *QUICK)[0] == 0

@@ -11,10 +11,11 @@ import numpy as np
 import pytest
 
 import main
-from rlcore import export
 from rlcore.errors import UserError
-from rlcore.export_parity import ABS_TOLERANCE, REL_TOLERANCE, ParityError, collect_observations
-from rlcore.policies import load_policy
+from rlcore.algorithms.registry import family
+from rlcore.models import export
+from rlcore.models.export_parity import ABS_TOLERANCE, REL_TOLERANCE, ParityError, collect_observations
+from rlcore.models.policies import load_policy
 from tests.cpu_support import needs_bfloat16
 
 SHIPPED = Path(__file__).resolve().parents[1] / "saved_networks"
@@ -55,10 +56,10 @@ def test_every_kind_exports_in_every_format_and_matches_keras(model, fmt, tmp_pa
 
 
 def test_sac_export_carries_its_standardize_layer():
-    from rlcore.layers import Standardize
+    from rlcore.networks.layers import Standardize
 
     exp, meta, policy = load_policy(SHIPPED / "minitaur" / "sac")
-    acting, as_trained = export.acting_network(policy.model, "sac")
+    acting, as_trained = export.acting_network(policy.model, family("sac").acting_network)
     standardize = [layer for layer in policy.model.layers if isinstance(layer, Standardize)]
     assert standardize and as_trained is None
     assert not np.allclose(standardize[0].var.numpy(), 1.0)  # the running statistics, not the defaults
@@ -70,10 +71,10 @@ def test_sac_export_carries_its_standardize_layer():
 
 @needs_bfloat16
 def test_a_bfloat16_network_is_exported_in_float32():
-    from rlcore.agents.ppo import build_actor_critic
+    from rlcore.algorithms.ppo.agent import build_actor_critic
 
     model = build_actor_critic((16, 16, 4), 3, precision="bfloat16")
-    acting, as_trained = export.acting_network(model, "ppo")
+    acting, as_trained = export.acting_network(model, family("ppo").acting_network)
     assert as_trained == "bfloat16"
     assert {layer.dtype_policy.name for layer in acting.layers} == {"float32"}
     frames = np.random.default_rng(0).integers(0, 256, (8, 16, 16, 4), dtype=np.uint8)
@@ -89,7 +90,7 @@ def test_a_failed_parity_check_is_one_line_and_keeps_the_earlier_export(monkeypa
     assert "parity:" in printed and "passed" in printed
     before = (out / "export.json").read_text()
 
-    from rlcore import export_parity
+    from rlcore.models import export_parity
     real = export_parity._run_savedmodel
     monkeypatch.setattr(export_parity, "_run_savedmodel", lambda path, obs: real(path, obs) + 0.01)
     with pytest.raises(ParityError, match="failed its parity check"):

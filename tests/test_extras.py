@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from rlcore.errors import UserError
-from rlcore.extras import install_command, require
+from rlcore.host.extras import install_command, require
 
 ROOT = Path(__file__).resolve().parents[1]
 OPTIONAL = ["nes_py", "gym_super_mario_bros", "cv2", "pybullet", "pybullet_data", "pybullet_utils", "ray",

@@ -7,8 +7,8 @@ import pytest
 from PIL import Image
 
 import main
-from rlcore.experiment import get_experiment
-from rlcore.video import GIF_WIDTH, _Gif, gif_every, record_video
+from rlcore.environments.registry import get_experiment
+from rlcore.models.video import GIF_WIDTH, _Gif, gif_every, record_video
 
 
 def _durations(path: Path) -> list[int]:

@@ -13,9 +13,9 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-from tests.test_cli import run as cli
 from rlcore import api
 from rlcore.errors import UserError
+from tests.test_cli import run as cli
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -56,7 +56,7 @@ def test_acrobot(tmp_path, algo, budget):
 
 
 def test_one_hot_is_the_index_of_a_discrete_observation():
-    from rlcore.gym_experiment import OneHotObservation, one_hot
+    from rlcore.environments.gym_experiment import OneHotObservation, one_hot
 
     assert one_hot(2, gym.spaces.Discrete(4)).tolist() == [0, 0, 1, 0]
     assert one_hot(-1, gym.spaces.Discrete(3, start=-1)).tolist() == [1, 0, 0]  # a space starting at -1
@@ -172,7 +172,7 @@ def test_mismatch_is_one_line_and_exit_2(tmp_path, capsys, env_id, algo, message
 
 def test_image_env_with_dqn_names_what_dqn_needs(tmp_path):
     """An image env with discrete actions: PPO's CNN fits, the DQN family does not."""
-    from rlcore.experiment import get_experiment
+    from rlcore.environments.registry import get_experiment
 
     gym.register("ImageSign-v0", entry_point="tests.toy:ImageSignEnv")
     try:
@@ -198,7 +198,7 @@ def test_every_hyperparameter_is_a_flag_and_checked(capsys):
 
 
 def test_a_user_env_run_is_named_as_trained_or_by_its_id():
-    from rlcore.gym_experiment import names_the_env
+    from rlcore.environments.gym_experiment import names_the_env
 
     assert names_the_env("tests.user_env:Chase-v0", "tests.user_env:Chase-v0")
     assert names_the_env("Chase-v0", "tests.user_env:Chase-v0") and names_the_env(None, "lunar_lander")

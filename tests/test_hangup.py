@@ -14,7 +14,7 @@ import threading
 import time
 from pathlib import Path
 
-from rlcore.checkpoint import read_checkpoint_state
+from rlcore.files.checkpoint import read_checkpoint_state
 from tests.test_stop_signals import group_is_gone
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -73,7 +73,7 @@ def test_a_terminal_stream_that_hung_up_swallows_writes_and_nothing_else():
 
     import pytest
 
-    from rlcore.trainers.stopping import HangupSafe
+    from rlcore.training.stopping import HangupSafe
 
     class Terminal:
         def __init__(self, error):

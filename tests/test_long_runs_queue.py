@@ -5,7 +5,7 @@ import json
 import signal
 from pathlib import Path
 
-from rlcore.command_line import build_parser
+from rlcore.cli.parser import build_parser
 
 ROOT = Path(__file__).resolve().parents[1]
 spec = importlib.util.spec_from_file_location("long_runs_queue", ROOT / "long_runs" / "queue.py")
@@ -80,3 +80,12 @@ def test_a_step_that_stops_or_fails_ends_the_queue_with_its_status(monkeypatch, 
     monkeypatch.setattr(queue.subprocess, "call", lambda argv, cwd: 0)
     assert queue.main([]) == 0 and "queue: nothing left to run" in capsys.readouterr().out
     assert {number: signal.getsignal(number) for number in before} == before  # the caller's handlers are back
+
+
+def test_the_readme_gives_the_queues_command():
+    documented = (ROOT / "long_runs" / "README.md").read_text().replace("\\\n    ", "")
+    line = next(line for line in documented.splitlines() if line.startswith("python main.py train mario_ppo ppo --preset flag"))
+    for level in queue.LEVELS:
+        world, stage = level.split("-")
+        given = line.replace("--world W --stage S", f"--world {world} --stage {stage}").replace("W-S", level)
+        assert vars(_parses(given.split()[2:])) == vars(_parses(queue.train_command(level, level, [])))

@@ -6,10 +6,12 @@ from pathlib import Path
 
 import pytest
 
-from rlcore import api, cli, shipping
+from rlcore import api
+from rlcore.cli import main as cli
 from rlcore.errors import UserError
+from rlcore.models import shipping
 
-CHECKOUT_MODELS = Path(shipping.__file__).resolve().parents[1] / "saved_networks"
+CHECKOUT_MODELS = Path(shipping.__file__).resolve().parents[2] / "saved_networks"
 
 
 @pytest.fixture

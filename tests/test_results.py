@@ -6,7 +6,7 @@ import json
 import numpy as np
 import pytest
 
-from rlcore.report import load_runs, summarize
+from rlcore.runs.report import load_runs, summarize
 from tests.test_cli import ROOT
 
 KEPT = ROOT / "results" / "sweeps"
@@ -21,7 +21,7 @@ def test_the_kept_sweeps_are_in_the_clone():
 def test_the_readme_quotes_each_kept_sweeps_iqm_and_interval(name):
     import json
 
-    from rlcore.score_words import return_digits
+    from rlcore.runs.score_words import return_digits
 
     runs = load_runs(KEPT / name)
     experiment, model = name.split("__")
@@ -38,7 +38,7 @@ def test_the_readme_quotes_each_kept_sweeps_iqm_and_interval(name):
 
 def shipped_bar(experiment: str, model: str):
     """The registry's bar over seeds for a shipped model (None where none is set)."""
-    from rlcore.docgen_data import shipped_models
+    from tools.docgen.data import shipped_models
 
     found = [m for m in shipped_models() if m.folder == f"saved_networks/{experiment}/{model}"]
     assert len(found) == 1, f"no shipped model in saved_networks/{experiment}/{model}"
@@ -47,7 +47,7 @@ def shipped_bar(experiment: str, model: str):
 
 def readme_iqm_cell(name: str) -> str:
     """The "same recipe over seeds [95% CI]" cell (the last) of the README row of this sweep's shipped model (the row
-    that links to its card). The generator writes it (rlcore.docgen); this recomputes it from the runs."""
+    that links to its card). The generator writes it (tools.docgen); this recomputes it from the runs."""
     experiment, algo = name.split("__")
     card = f"(saved_networks/{experiment}/{algo}/README.md)"
     rows = [line for line in (ROOT / "README.md").read_text().splitlines()
@@ -60,9 +60,9 @@ def readme_iqm_cell(name: str) -> str:
 def test_the_experiment_page_tells_each_kept_sweeps_collapses_as_its_evaluations_show_them(name):
     """The page's summary of collapses and keep-best (docgen's sweep-stability region) recomputed from the
     kept evals.csv files; and each seed's collapses are listed with where each fell and came back."""
-    from rlcore.critic_trace import critic_cell, critic_trace
-    from rlcore.docgen_sweeps import collapses_cell
-    from rlcore.eval_history import stability_summary
+    from rlcore.runs.critic_trace import critic_cell, critic_trace
+    from rlcore.runs.eval_history import stability_summary
+    from tools.docgen.sweeps import collapses_cell
 
     experiment, model = name.split("__")
     page = (ROOT / "docs" / "experiments" / f"{experiment}.md").read_text()
@@ -86,7 +86,7 @@ def test_the_experiment_page_tells_each_kept_sweeps_collapses_as_its_evaluations
 def test_each_kept_report_tells_the_runs_stories_as_the_code_reads_them_now(name):
     """report.md is written once by `report --keep`; when the rule that reads evals.csv changes, the kept
     reports are written again (`main.py report results/sweeps/NAME`), and this says which are stale."""
-    from rlcore.report import critic_lines, stability_lines
+    from rlcore.runs.report import critic_lines, stability_lines
 
     report = (KEPT / name / "report.md").read_text()
     runs = load_runs(KEPT / name)
@@ -96,8 +96,8 @@ def test_each_kept_report_tells_the_runs_stories_as_the_code_reads_them_now(name
 
 def test_a_seed_summary_gives_the_iqm_each_seed_and_the_shipped_model_beside_them():
     """The README's paragraph per kept sweep (docgen's seed-summary region), on the CartPole DQN sweep."""
-    from rlcore.docgen_sweeps import seed_summary
-    from rlcore.eval_history import stability_summary
+    from rlcore.runs.eval_history import stability_summary
+    from tools.docgen.sweeps import seed_summary
 
     text = seed_summary("README.md", "cartpole")
     runs = load_runs(KEPT / "cartpole__dqn")
@@ -120,11 +120,11 @@ def kept_models() -> list[str]:
 @pytest.mark.parametrize("run", kept_models())
 def test_a_kept_runs_model_plays_its_recorded_first_episode_again(run):
     """Held-out checks replay a kept run's model. On the machine that recorded its evaluation the first
-    recorded episode repeats exactly (rlcore.machine); elsewhere it plays that seed to its end (oneDNN may
+    recorded episode repeats exactly (rlcore.host.machine); elsewhere it plays that seed to its end (oneDNN may
     take another course on another CPU, and a seed of a sweep need not clear the shipped model's bar)."""
-    from rlcore import machine
-    from rlcore.evaluation import evaluate, evaluate_success
-    from rlcore.policies import load_policy
+    from rlcore.host import machine
+    from rlcore.models.policies import load_policy
+    from rlcore.training.evaluation import evaluate, evaluate_success
     from tests.cpu_support import skip_where_its_precision_cannot_run
 
     skip_where_its_precision_cannot_run(json.loads((KEPT / run / "model" / "meta.json").read_text()))
@@ -148,7 +148,7 @@ def test_a_kept_runs_model_plays_its_recorded_first_episode_again(run):
 def test_what_ended_a_run_is_said_in_words_and_an_unknown_rule_as_recorded():
     from types import SimpleNamespace
 
-    from rlcore.docgen_sweeps import stop_text
+    from tools.docgen.sweeps import stop_text
 
     mario = SimpleNamespace(experiment="mario_ppo", name="1-1")
     said = {"max_env_steps 1000000": "its budget of 1,000,000 env steps",
@@ -166,8 +166,8 @@ def test_what_ended_a_run_is_said_in_words_and_an_unknown_rule_as_recorded():
 def test_a_seeds_score_gives_its_full_length_share_where_the_bar_asks_for_one():
     from types import SimpleNamespace
 
-    from rlcore.docgen_sweeps import evaluation_cell
-    from rlcore.experiment import get_experiment
+    from rlcore.environments.registry import get_experiment
+    from tools.docgen.sweeps import evaluation_cell
 
     minitaur = SimpleNamespace(experiment="minitaur", name="sac", bar=get_experiment("minitaur").bar("sac"),
                                evaluation={"mean": 20.45})  # the shipped model's: two decimals
@@ -185,8 +185,8 @@ def test_a_headline_recipe_is_held_to_its_bar_over_seeds_and_the_summary_says_wh
     least 5 of 10. The README's seed summary says met or not met from the kept sweep's report."""
     from types import SimpleNamespace
 
-    from rlcore.docgen_sweeps import seeds_bar_text
-    from rlcore.experiment import get_experiment
+    from rlcore.environments.registry import get_experiment
+    from tools.docgen.sweeps import seeds_bar_text
 
     minitaur = get_experiment("minitaur").bar("sac").over_seeds
     mario = get_experiment("mario_ppo").bar("1-1").over_seeds

@@ -5,9 +5,9 @@ import json
 import numpy as np
 import pytest
 
+from rlcore.environments.registry import get_experiment
+from rlcore.hyperparams.flags import defining_fields, to_dict
 from tests.test_cli import run
-from rlcore.experiment import get_experiment
-from rlcore.hparams import defining_fields, to_dict
 
 
 def fake_run(folder, experiment: str, algo: str, preset: str = "default", seed: int = 0, **changes):
@@ -61,7 +61,7 @@ def test_every_env_field_and_network_size_is_a_defining_field():
 def test_resume_may_change_budgets_rates_and_coefficients(tmp_path):
     """Given again with a new value, or a defining field with its recorded one: accepted."""
     folder = fake_run(tmp_path / "run", "lunar_lander", "dqn")
-    from rlcore.run import build_spec
+    from rlcore.training.run import build_spec
 
     spec = build_spec("lunar_lander", "dqn", run_dir=folder, resume=True,
                       overrides={"lr": 1e-4, "max_episodes": 50, "tau": 0.01, "hidden": get_experiment("lunar_lander").preset("dqn", None).hidden})
@@ -87,8 +87,8 @@ def test_resume_refuses_another_init_from_and_takes_its_own_folder_written_anoth
     """init_from is used once, at a run's start, and recorded: another folder on a resume is refused (it was
     recorded and ignored); the recorded folder in another spelling (absolute, ./, a trailing slash, a Path
     from Python) is no change at all, and none is recorded."""
-    from rlcore.api_train import _overrides
-    from rlcore.run import build_spec
+    from rlcore.api.training import _overrides
+    from rlcore.training.run import build_spec
     from tests.test_cli import ROOT
 
     monkeypatch.chdir(ROOT)
@@ -124,7 +124,7 @@ def test_a_flag_that_would_do_nothing_is_refused(capsys, tmp_path, argv, words):
 
 
 def test_the_same_flags_with_what_they_need_are_accepted():
-    from rlcore.hparams import apply_overrides, check_no_inert
+    from rlcore.hyperparams.flags import apply_overrides, check_no_inert
 
     mario = get_experiment("mario_ppo").preset("ppo", None)
     for given in ({"restart_x": 500, "restart_share": 0.3}, {"restart_every": 400, "restart_weights": "deaths"},

@@ -7,7 +7,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from rlcore.run_lock import RunFolderBusy, hold_run_folder
+from rlcore.files.run_lock import hold_run_folder
 from tests.test_cli import run
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -16,7 +16,7 @@ QUICK = ["--wandb", "off", "--no-progress", "--final-eval-episodes", "0"]
 
 def hold_elsewhere(folder: Path) -> subprocess.Popen:
     """Another process that holds the folder's lock until killed."""
-    code = ("import sys, time; from rlcore.run_lock import hold_run_folder\n"
+    code = ("import sys, time; from rlcore.files.run_lock import hold_run_folder\n"
             "with hold_run_folder(sys.argv[1]):\n    print('held', flush=True); time.sleep(600)")
     holder = subprocess.Popen([sys.executable, "-c", code, str(folder)], cwd=ROOT, stdout=subprocess.PIPE,
                               text=True)
@@ -54,7 +54,7 @@ def test_a_process_may_reenter_its_own_lock_and_another_may_not(tmp_path):
             pass
         holder_line = (folder / ".lock").read_text().strip()
         assert holder_line.isdigit()
-        other = subprocess.run([sys.executable, "-c", "import sys; from rlcore.run_lock import hold_run_folder\n"
+        other = subprocess.run([sys.executable, "-c", "import sys; from rlcore.files.run_lock import hold_run_folder\n"
                                 "with hold_run_folder(sys.argv[1]): pass", str(folder)],
                                cwd=ROOT, capture_output=True, text=True)
         assert other.returncode != 0 and "RunFolderBusy" in other.stderr
@@ -82,7 +82,7 @@ def test_a_lock_on_a_lock_file_removed_meanwhile_is_not_held(tmp_path):
     lock the new file too: the lock checks that its file is still the folder's, and takes the new one."""
     import os
 
-    from rlcore.run_lock import _lock, _still_there
+    from rlcore.files.run_lock import _lock, _still_there
 
     folder = tmp_path / "run"
     fd = _lock(folder)

@@ -1,6 +1,6 @@
 """Every shipped model loads from its .h5, clears its bar, still plays, and carries its story.
 
-Two ways to check that a model still plays, chosen by :func:`rlcore.machine.replays_exactly`:
+Two ways to check that a model still plays, chosen by :func:`rlcore.host.machine.replays_exactly`:
 
 - where its evaluation was recorded (the same CPU and package versions), its first seeded episodes
   must repeat the record exactly;
@@ -18,11 +18,11 @@ import imageio.v3 as iio
 import numpy as np
 import pytest
 
-from rlcore import machine
-from rlcore.evaluation import evaluate, evaluate_success
-from rlcore.experiment import experiment_names, get_experiment
-from rlcore.policies import load_policy
-from rlcore.video import record_video
+from rlcore.environments.registry import experiment_names, get_experiment
+from rlcore.host import machine
+from rlcore.models.policies import load_policy
+from rlcore.models.video import record_video
+from rlcore.training.evaluation import evaluate, evaluate_success
 from tests.cpu_support import skip_where_its_precision_cannot_run
 
 SHIPPED = Path(__file__).resolve().parents[1] / "saved_networks"

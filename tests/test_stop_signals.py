@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from rlcore.checkpoint import read_checkpoint_state
+from rlcore.files.checkpoint import read_checkpoint_state
 
 ROOT = Path(__file__).resolve().parents[1]
 # a short Mario run over a pool of 2 env processes: 64 transitions per rollout, one quick update

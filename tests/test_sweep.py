@@ -12,11 +12,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rlcore import experiment as registry
-from rlcore.checkpoint import read_checkpoint_state
-from rlcore.report import load_runs, summarize
-from rlcore.sweep import STOP_FILE, Sweep
-from rlcore.sweep_ray import run_sweep, start_ray
+from rlcore.environments import registry
+from rlcore.files.checkpoint import read_checkpoint_state
+from rlcore.runs.report import load_runs, summarize
+from rlcore.sweeps.on_ray import run_sweep, start_ray
+from rlcore.sweeps.sweep import STOP_FILE, Sweep
 from tests.processes import alive, listening, outside_loopback, own_ray_processes
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -159,7 +159,7 @@ def test_a_stopped_sweep_does_not_begin_the_trials_still_waiting(local_ray, tmp_
 def test_a_trial_that_fails_with_a_user_error_is_reported_once_not_retried(local_ray, tmp_path):
     """Its run folder is written by another process (this one): the trial is refused, and a retry
     would be refused the same way, so there is none."""
-    from rlcore.run_lock import hold_run_folder
+    from rlcore.files.run_lock import hold_run_folder
 
     sweep = _sweep(tmp_path, "busy", seeds=(0,))
     with hold_run_folder(tmp_path / "busy" / "seed=0"):

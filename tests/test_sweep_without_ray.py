@@ -14,11 +14,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rlcore.bootstrap import aggregates, probability_of_improvement, stratified_bootstrap_ci
-from rlcore.report import load_runs, summarize
-from rlcore.sweep import Sweep, parse_grid, parse_seeds
-from tests.test_cli import run
+from rlcore.runs.bootstrap import aggregates, probability_of_improvement, stratified_bootstrap_ci
+from rlcore.runs.report import load_runs, summarize
+from rlcore.sweeps.sweep import Sweep, parse_grid, parse_seeds
 from tests.processes import group_pids, listening, outside_loopback
+from tests.test_cli import run
 from tests.test_sweep import ROOT, _sweep, _wait_for
 
 
@@ -51,7 +51,7 @@ def test_a_sweep_moved_to_another_folder_resumes_where_it_now_is(tmp_path):
 
 
 def test_seeds_and_grid_parsing():
-    from rlcore.configs import DQNConfig
+    from rlcore.algorithms.dqn.config import DQNConfig
 
     assert parse_seeds("0-4") == [0, 1, 2, 3, 4] and parse_seeds("0,3,7") == [0, 3, 7]
     assert parse_grid(["lr=1e-4,3e-4", "hidden=64,64;128"], DQNConfig()) == {
@@ -81,7 +81,7 @@ def test_bad_sweep_values_are_one_line_and_exit_2(capsys, tmp_path, monkeypatch,
 
 
 def test_report_groups_a_grid_sweep_by_setting(tmp_path):
-    from rlcore.report import markdown
+    from rlcore.runs.report import markdown
 
     # skewed scores, so mean, median and IQM differ and a mix-up of their names would show
     for lr, scores in (("0.001", (137.0, 278.0, 487.0, 500.0, 500.0)), ("0.01", (600.0, 601.0, 650.0))):
@@ -159,7 +159,7 @@ def test_a_report_of_two_sweeps_leaves_each_sweeps_own_report_alone(tmp_path, ca
 
 
 def test_report_tells_each_runs_collapses_and_which_weights_its_model_holds(tmp_path):
-    from rlcore.report import markdown
+    from rlcore.runs.report import markdown
 
     header = "env_steps,episode,eval_mean,eval_std,eval_time_limit_share\n"
     for seed, (means, weights) in enumerate((((0.0, 15.0, 0.5, 16.0, 12.0), "best periodic evaluation"),
@@ -210,7 +210,9 @@ def test_single_runs_over_seeds_are_kept_and_reported_as_a_sweep_of_their_level(
     """Mario 1-1's seeds are three `train` runs: `report RUN... --keep DIR` keeps them like a sweep (a budget
     given again on a resume may differ), and the docs generator finds them as the sweep of level 1-1."""
     # imported before docgen_data.REPO points at tmp_path below: a module imported while it does would keep it
-    from rlcore import docgen, docgen_cards, docgen_data, docgen_sweeps  # noqa: F401
+    from tools.docgen import data as docgen_data
+    from tools.docgen import regions as docgen  # noqa: F401
+    from tools.docgen import sweeps as docgen_sweeps
 
     budget_again = ({"max_env_steps": [10**7, 2 * 10**7]}, {})  # seed 1 resumed twice: a new budget, then nothing
     runs = [str(_mario_run(tmp_path / "long_runs" / f"1-1-seed-{s}", s, flags, further, resumes, max_env_steps=budget))
@@ -234,7 +236,7 @@ def test_single_runs_over_seeds_are_kept_and_reported_as_a_sweep_of_their_level(
     found = docgen_data.kept_sweeps()
     assert list(found) == [("mario_ppo", "1-1")] and found[("mario_ppo", "1-1")].seeds == [(0, 0.9), (1, 1.0), (2, 0.6)]
     # the docs' regions for it, beside a shipped 1-1 (flag in 8 of 10); PPO has no periodic evaluations
-    from rlcore.experiment import get_experiment
+    from rlcore.environments.registry import get_experiment
 
     shipped = docgen_data.Model("mario_ppo", "1-1", "saved_networks/mario_ppo/1-1",
                                 {"algo": "ppo", "seed": 0, "evaluation": {"episodes": 10, "success_share": 0.8}},
@@ -267,7 +269,7 @@ def test_a_goal_tasks_report_draws_the_success_share_the_stop_rule_reads(tmp_pat
     """Mario's seeds are scored by the flag: report_success.png draws metrics.csv's success_share (the share of
     the last 100 episodes from the start, what --stop-success-share reads), with the runs' stop share; a level
     x-4 ends at the axe."""
-    from rlcore.report_plots import SUCCESS_SHARE, _goal, run_curve
+    from rlcore.runs.report_plots import SUCCESS_SHARE, _goal, run_curve
 
     for s in range(2):
         _mario_run(tmp_path / "runs" / f"seed={s}", s, 8, stop_success_share=0.9)
@@ -350,7 +352,7 @@ def test_a_trial_killed_before_its_first_checkpoint_starts_over_without_its_old_
     not kept under the new run's (they would repeat episode numbers and mix two runs' curves)."""
     import dataclasses
 
-    from rlcore.sweep_trial import run_trial
+    from rlcore.sweeps.trial import run_trial
     sweep = _sweep(tmp_path, "early", seeds=(0,))
     trial = tmp_path / "early" / "seed=0"
     trial.mkdir(parents=True)
@@ -434,7 +436,7 @@ def test_tune_warns_of_no_slow_report_even_when_imported_before_the_sweep(monkey
     threshold for "may be a performance bottleneck" lines: the threshold Tune derived then is set too."""
     from ray.tune.utils import util
 
-    from rlcore.sweep_ray import quiet_tune
+    from rlcore.sweeps.on_ray import quiet_tune
 
     monkeypatch.setattr(util.warn_if_slow, "DEFAULT_THRESHOLD", 0.5)  # as Tune reads it without the variable
     monkeypatch.setenv("TUNE_WARN_THRESHOLD_S", "")
@@ -447,8 +449,8 @@ def test_a_run_resumed_before_resumes_recorded_their_changes_is_not_kept():
     """Records from before 2026-11-27 list the commands but no command_starts: the resumes are there, what
     they changed is not, so the keep cannot show that they changed budgets only."""
     from rlcore.errors import UserError
-    from rlcore.keeping import check_one_recipe_throughout
-    from rlcore.run_commands import command_starts
+    from rlcore.runs.commands import command_starts
+    from rlcore.runs.keeping import check_one_recipe_throughout
 
     old = {"commands": ["python main.py train mario_ppo ppo --seed 0", "python main.py train mario_ppo ppo --resume R"]}
     assert command_starts(old) == [None, None]
@@ -465,7 +467,7 @@ def test_a_trial_trained_but_not_evaluated_is_evaluated_on_resume_and_never_left
     import dataclasses
 
     from rlcore.errors import UserError
-    from rlcore.sweep_trial import run_trial
+    from rlcore.sweeps.trial import run_trial
     sweep = _sweep(tmp_path, "late", seeds=(0,))
     Path(sweep.folder).mkdir()
     sweep.save()
@@ -507,7 +509,7 @@ def test_the_end_of_a_run_is_imported_at_its_start():
     script = """
 import ast, importlib, sys
 from pathlib import Path
-import rlcore.run as run
+import rlcore.training.run as run
 run._import_the_end_of_a_run()
 missing = set()
 for name in run.END_OF_RUN_MODULES:
@@ -522,7 +524,7 @@ for name in run.END_OF_RUN_MODULES:
                 missing |= {a.name for a in node.names if a.name.startswith("rlcore.")} - set(sys.modules)
 # api.export's module, which no run calls at its end; the agents snapshot.py builds by kind: a run's own
 # agent module is loaded by its trainer before it trains
-print(sorted(m for m in missing if m != "rlcore.export" and not m.startswith("rlcore.agents.")))
+print(sorted(m for m in missing if m != "rlcore.models.export" and not m.startswith("rlcore.algorithms.")))
 """
     done = subprocess.run([sys.executable, "-c", script], cwd=ROOT, capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr[-2000:]
@@ -530,7 +532,7 @@ print(sorted(m for m in missing if m != "rlcore.export" and not m.startswith("rl
 
 
 def test_run_training_imports_the_end_of_the_run_before_it_trains(monkeypatch, tmp_path):
-    from rlcore import run
+    from rlcore.training import run
 
     class Imported(Exception):
         pass

@@ -5,7 +5,6 @@ import sys
 import tempfile
 from pathlib import Path
 
-import rlcore
 from rlcore import api
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -35,10 +34,10 @@ api.resume(42)
 
 def test_public_names_are_listed_and_typed():
     for name in api.__all__:
-        assert getattr(api, name).__module__ in ("rlcore.api", "rlcore.api_train", "rlcore.experiment", "rlcore.errors",
-                                                  "rlcore.trainers.stopping", "typing")
-    import rlcore.export  # the export code keeps its module name: the API is rlcore.api, not rlcore itself
-    assert callable(rlcore.export.export_model) and callable(api.export)
+        assert getattr(api, name).__module__ in ("rlcore.api", "rlcore.api.models", "rlcore.api.training", "rlcore.environments.experiment", "rlcore.errors",
+                                                  "rlcore.training.stopping", "typing")
+    import rlcore.models.export  # the export code keeps its module name: the API is rlcore.api, not rlcore itself
+    assert callable(rlcore.models.export.export_model) and callable(api.export)
     for function in (api.train, api.resume, api.load, api.evaluate, api.render, api.export):
         assert "return" in function.__annotations__ and function.__doc__
     assert (ROOT / "rlcore" / "py.typed").is_file()
@@ -51,7 +50,8 @@ def test_mypy_over_the_public_api_and_user_code(tmp_path):
     done = subprocess.run(
         [sys.executable, "-m", "mypy", "--config-file", str(ROOT / "tests" / "mypy_api.ini"),
          "--cache-dir", str(Path(tempfile.gettempdir()) / "deeprl-mypy-cache"), "--no-error-summary",
-         "rlcore/api.py", "rlcore/api_train.py", "rlcore/gym_experiment.py", str(tmp_path / "user_ok.py"), str(tmp_path / "user_wrong.py")],
+         "rlcore/api/__init__.py", "rlcore/api/models.py", "rlcore/api/training.py",
+         "rlcore/environments/gym_experiment.py", str(tmp_path / "user_ok.py"), str(tmp_path / "user_wrong.py")],
         cwd=ROOT, capture_output=True, text=True, timeout=300)
     errors = [line for line in done.stdout.splitlines() if ": error:" in line]
     outside = [line for line in errors if "user_wrong.py" not in line]

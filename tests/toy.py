@@ -8,9 +8,15 @@ import dataclasses
 import gymnasium as gym
 import numpy as np
 
-from rlcore.configs import A2CConfig, DQNConfig, PPOConfig, SACConfig
-from rlcore.experiment import AlgoSpec, Experiment, Goal
-from rlcore.trainers import a2c, dqn, ppo, sac
+from rlcore.algorithms.a2c import train as a2c
+from rlcore.algorithms.a2c.config import A2CConfig
+from rlcore.algorithms.dqn import train as dqn
+from rlcore.algorithms.dqn.config import DQNConfig
+from rlcore.algorithms.ppo import train as ppo
+from rlcore.algorithms.ppo.config import PPOConfig
+from rlcore.algorithms.sac import train as sac
+from rlcore.algorithms.sac.config import SACConfig
+from rlcore.environments.experiment import AlgoSpec, Experiment, Goal
 
 TRAINERS = {"dqn": dqn, "a2c": a2c, "ppo": ppo, "sac": sac}  # each module's train(spec) runs one run
 
@@ -62,7 +68,7 @@ EXPERIMENT = Experiment(
 
 
 def spec(algo, tmp_path, **overrides):
-    from rlcore.trainers.spec import RunSpec
+    from rlcore.training.spec import RunSpec
 
     experiment = {"ppo": IMAGE_EXPERIMENT, "sac": REACH_EXPERIMENT}.get(algo, EXPERIMENT)
     cfg = dataclasses.replace(experiment.preset(algo, None), **overrides)

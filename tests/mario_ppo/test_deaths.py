@@ -101,7 +101,7 @@ def test_on_the_emulator_running_right_on_1_1_meets_the_first_goomba():
 
 
 def test_count_causes_counts_by_name_most_first():
-    from rlcore.evaluation import count_causes
+    from rlcore.training.evaluation import count_causes
 
     records = [{"killed_by": c} for c in (0x0A, math.nan, 0x1B, 0x1C, FELL, 0x0A, 0x1D)] + [{"success": True}]
     assert count_causes(records, "killed_by", cause_name) == [("Firebar", 3), ("grey Cheep-cheep", 2),

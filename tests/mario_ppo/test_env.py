@@ -5,8 +5,8 @@ import pytest
 
 from mario_ppo.deaths import KilledBy
 from mario_ppo.env import FRAME_SIZE, SkipAndHistory, SkipAndStack, gray_84, make_env
-from mario_ppo.rewards import ClassicReward, classic_reward
 from mario_ppo.episode_ends import DeadEnds, StallLimit
+from mario_ppo.rewards import ClassicReward, classic_reward
 from rlcore.errors import UserError
 from tests.mario_ppo.scripted import ScriptedInfos
 
@@ -31,8 +31,8 @@ def test_observation_is_four_gray_uint8_frames(env):
 
 def test_step_stacks_the_four_skipped_frames_in_order(env):
     """Replaying the same actions frame by frame on a second emulator gives the same four frames."""
-    import gymnasium as gym
     import gym_super_mario_bros  # noqa: F401
+    import gymnasium as gym
     from gym_super_mario_bros.actions import SIMPLE_MOVEMENT
     from nes_py.wrappers import JoypadSpace
 

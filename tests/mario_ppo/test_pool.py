@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from mario_ppo.experiment import EXPERIMENT
-from rlcore.vector import EnvPool, EnvWorkerDied
+from rlcore.environments.vector import EnvPool, EnvWorkerDied
 
 N = 2
 

@@ -13,7 +13,7 @@ from mario_ppo.curriculum import X_KEY, StepBack, lend_routes
 from mario_ppo.env import make_env
 from mario_ppo.experiment import EXPERIMENT
 from rlcore.errors import UserError
-from rlcore.trainers import checkpoints
+from rlcore.training import checkpoints
 from tests.mario_ppo.test_restarts import _restarts, _run_right_past
 
 X, GOAL, STEP, WINDOW = 160, 230, 40, 3

@@ -2,8 +2,8 @@
 import gymnasium as gym
 import numpy as np
 
-from mario_ppo.env import SkipAndHistory, SkipAndStack, action_list, make_env
 from mario_ppo.emulator_states import WARMUP
+from mario_ppo.env import SkipAndHistory, SkipAndStack, action_list, make_env
 from mario_ppo.restarts import Restarts
 
 RIGHT = 1  # SIMPLE_MOVEMENT[1] == ['right']

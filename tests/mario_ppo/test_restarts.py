@@ -146,8 +146,8 @@ def test_a_fresh_env_given_the_kept_routes_restarts_where_the_first_one_did():
 
 
 def test_a_pool_of_processes_hands_the_routes_out_and_back():
-    from rlcore.trainers import checkpoints
-    from rlcore.vector import EnvPool
+    from rlcore.environments.vector import EnvPool
+    from rlcore.training import checkpoints
 
     cfg = dataclasses.replace(EXPERIMENT.preset("ppo", "default"), restart_every=EVERY, restart_share=1.0)
     factory = EXPERIMENT.training_env_factory(cfg)

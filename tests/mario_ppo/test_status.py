@@ -99,7 +99,7 @@ def test_status_shows_blocks_of_rollouts_with_update_sizes_and_the_learning_rate
 def test_status_says_where_the_success_share_stop_rule_stands(capsys, tmp_path):
     """A run stopped by --stop-success-share: the flags of the last `window` counted episodes against it,
     and before the window is full, how many of it have been played."""
-    from rlcore.checkpoint import save_checkpoint
+    from rlcore.files.checkpoint import save_checkpoint
 
     rows = [HEADER] + [f"{i},10,0,0,{100 * i},20,{int(i % 4 == 0)},0,0," for i in range(1, 31)]
     (tmp_path / "metrics.csv").write_text("\n".join(rows) + "\n")

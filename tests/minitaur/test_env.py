@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from minitaur.env import ENV_ID, SUBSTEP, MinitaurEnv, make_env
-from minitaur.motor import MotorModel, OBSERVED_TORQUE_LIMIT
+from minitaur.motor import OBSERVED_TORQUE_LIMIT, MotorModel
 from minitaur.robot import leg_model_to_motor_angles
 
 

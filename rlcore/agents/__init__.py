@@ -1,1 +1,0 @@
-"""Agents: one file per algorithm, Keras models and a compiled GradientTape train step."""

@@ -1,0 +1,209 @@
+"""Any registered Gymnasium id as an experiment: the algorithms that fit its spaces, each with a
+``default`` preset made of the algorithm's own defaults.
+
+    get_experiment("Acrobot-v1")            # a Gymnasium id
+    get_experiment("my_envs:Maze-v0")       # import my_envs (which calls gymnasium.register), then the id
+
+What fits (the agents read nothing of an env but its spaces):
+
+    dqn, ddqn, dueling_dqn, dueling_ddqn, a2c   Discrete actions, vector observations (a 1-D Box)
+    ppo                                         Discrete actions, vector observations (MLP body) or
+                                                uint8 images H x W x C (CNN body)
+    sac                                         Box actions with finite bounds (rescaled to [-1, 1],
+                                                the range of its tanh actor), vector observations
+
+A Discrete observation (FrozenLake's cell, Taxi's state number) is given to the networks one-hot, as a
+vector of n zeros and a one (Stable-Baselines3 does the same); the exported networks take that vector.
+
+A preset is the algorithm's config dataclass defaults, with episodes capped at the env's registered
+time limit, stopping once the last 100 episodes average the env's ``reward_threshold`` (when it has one)
+and the env pool in-process. Every field stays a flag (``--lr 3e-4``) or a keyword of
+:func:`rlcore.api.train`. TensorFlow-free.
+"""
+from __future__ import annotations
+
+import importlib
+import re
+from functools import partial
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from rlcore.algorithms.registry import FAMILIES, family
+from rlcore.environments.experiment import AlgoSpec, Experiment
+from rlcore.errors import UserError
+
+if TYPE_CHECKING:
+    import gymnasium
+    from gymnasium.envs.registration import EnvSpec
+
+NO_THRESHOLD_STOP = 1e9  # stop_score of an env without a reward threshold: run the whole budget
+
+_GYM_ID = re.compile(r"^([\w.]+:)?([\w.-]+/)?[\w.-]+-v\d+$")
+
+
+def looks_like_gym_id(name: str) -> bool:
+    """``Acrobot-v1``, ``ALE/Pong-v5`` or ``my_envs:Maze-v0`` (a versioned Gymnasium id)."""
+    return bool(_GYM_ID.match(name))
+
+
+def split_module(name: str) -> tuple[str | None, str]:
+    """``"my_envs:Maze-v0"`` -> ``("my_envs", "Maze-v0")``; a plain id -> ``(None, id)``."""
+    module, _, env_id = name.rpartition(":")
+    return module or None, env_id
+
+
+def gym_spec(name: str) -> EnvSpec:
+    """The registered :class:`gymnasium.envs.registration.EnvSpec` of ``name`` (importing its module
+    first for ``module:id``), or a one-line :class:`UserError`."""
+    import gymnasium as gym
+
+    module, env_id = split_module(name)
+    if module is not None:
+        try:
+            importlib.import_module(module)
+        except ImportError as exc:
+            raise UserError(f"cannot import {module!r}, the module before ':' in {name!r} that should "
+                            f"register {env_id}: {exc}") from None
+    try:
+        return gym.spec(env_id)
+    except gym.error.Error as exc:
+        hint = (" (import the module that calls gymnasium.register first, or give MODULE:ID)"
+                if module is None else f" ({module} did not register it)")
+        raise UserError(f"{env_id} is not a registered Gymnasium id: {exc}{hint}") from None
+
+
+def names_the_env(given: str | None, recorded: str | None) -> bool:
+    """Whether ``given`` names the env a run recorded: its name, or for a user's ``MODULE:ID`` its id too."""
+    if given is None or given == recorded:
+        return True
+    return isinstance(recorded, str) and ":" in recorded and given == recorded.split(":", 1)[1]
+
+
+def register_from_record(record: dict) -> None:
+    """Register a user's env again from a model's meta.json (``env``: id and a string entry point) in a
+    process where the module that registered it was not imported. Nothing when the id is known."""
+    import gymnasium as gym
+
+    env_id, entry_point = record.get("gymnasium_id"), record.get("entry_point")
+    if not env_id or env_id in gym.registry or not isinstance(entry_point, str):
+        return
+    gym.register(env_id, entry_point=entry_point, kwargs=record.get("kwargs") or {},
+                 max_episode_steps=record.get("max_episode_steps"),
+                 reward_threshold=record.get("reward_threshold"))
+
+
+def make_gym_env(render_mode: str | None = None, max_episode_steps: int | None = None, *, name: str,
+                 rescale_actions: bool = False) -> gymnasium.Env:
+    """The env ``name`` (``module:id`` imports the module first) with its registered time limit unless
+    ``max_episode_steps`` is given; SAC's envs get their Box actions rescaled from [-1, 1]."""
+    import gymnasium as gym
+
+    module, env_id = split_module(name)
+    if module is not None:
+        importlib.import_module(module)  # a spawned pool worker registers the user's env here
+    env = gym.make(env_id, render_mode=render_mode, max_episode_steps=max_episode_steps)
+    if isinstance(env.observation_space, gym.spaces.Discrete):
+        env = OneHotObservation(env)
+    if rescale_actions:
+        env = gym.wrappers.RescaleAction(env, np.float32(-1.0), np.float32(1.0))
+    return env
+
+
+def one_hot(observation: int, space: gymnasium.spaces.Discrete) -> np.ndarray:
+    """The observation ``observation`` of a Discrete ``space`` (which may start at a value other than 0)
+    as a float32 vector of ``space.n`` zeros with a one at its index."""
+    vector = np.zeros(int(space.n), np.float32)
+    vector[int(observation) - int(space.start)] = 1.0
+    return vector
+
+
+def OneHotObservation(env: gymnasium.Env) -> gymnasium.Env:  # noqa: N802 (a wrapper, named as one)
+    """``env`` with its Discrete observations given one-hot, as a Box of n values in [0, 1]."""
+    import gymnasium as gym
+
+    space = env.observation_space
+    if not isinstance(space, gym.spaces.Discrete):
+        raise TypeError(f"one-hot needs a Discrete observation space, not {space}")
+    return gym.wrappers.TransformObservation(env, partial(one_hot, space=space),
+                                             gym.spaces.Box(0.0, 1.0, (int(space.n),), np.float32))
+
+
+def algorithms() -> dict[str, tuple[str, str, dict]]:
+    """Algorithm name -> (family kind, description, config switches): every variant of every family."""
+    return {name: (kind, description, switches) for kind, fam in FAMILIES.items()
+            for name, (description, switches) in fam.variants.items()}
+
+
+def misfit(kind: str, observation_space: gymnasium.Space, action_space: gymnasium.Space) -> str | None:
+    """Why an algorithm of ``kind`` cannot train on these spaces (one clause), or None when it can."""
+    return family(kind).misfit(observation_space, action_space)
+
+
+def default_preset(kind: str, switches: dict, reward_threshold: float | None) -> object:
+    """The algorithm's config defaults, for an env this package knows nothing of."""
+    fields = dict(max_episode_steps=0, stop_score=(NO_THRESHOLD_STOP if reward_threshold is None
+                                                    else float(reward_threshold)), **switches)
+    if family(kind).env_pool:
+        fields["vec"] = "inline"  # a Gymnasium env is cheap next to a pipe to another process
+    return family(kind).config(**fields)
+
+
+def gym_experiment(name: str) -> Experiment:
+    """The :class:`Experiment` of the Gymnasium id ``name`` (``module:id`` allowed); an unknown id is
+    a :class:`UserError`. Built once per process and name."""
+    key = (name, tuple(FAMILIES))  # a family registered since is offered too
+    if key not in _BUILT:
+        _BUILT[key] = _build(name)
+    return _BUILT[key]
+
+
+_BUILT: dict[tuple[str, tuple[str, ...]], Experiment] = {}
+
+
+def _build(name: str) -> Experiment:
+    spec = gym_spec(name)
+    env = make_gym_env(name=name)
+    try:
+        obs_space, act_space = env.observation_space, env.action_space
+        one_hot_obs = type(env.unwrapped.observation_space).__name__ == "Discrete"  # given one-hot
+        fps = int(env.metadata.get("render_fps") or 30)
+    finally:
+        env.close()
+    algos, unfit = {}, {}
+    for algo, (kind, description, switches) in algorithms().items():
+        reason = misfit(kind, obs_space, act_space)
+        if reason:
+            unfit[algo] = reason
+            continue
+        preset = default_preset(kind, switches, spec.reward_threshold)
+        algos[algo] = AlgoSpec(algo, kind, description, {"default": preset})
+    rescale = any(not family(algo.kind).discrete for algo in algos.values())
+    entry_point = spec.entry_point if isinstance(spec.entry_point, str) else None
+    return Experiment(
+        name=name,
+        description=f"Gymnasium {spec.id} (observations {obs_space}, actions {act_space})",
+        make_env=partial(make_gym_env, name=name, rescale_actions=rescale),
+        algos=algos,
+        solved_score=None if spec.reward_threshold is None else float(spec.reward_threshold),
+        plot_prefix=re.sub(r"[^\w.-]", "_", spec.id),
+        video_fps=fps,
+        unfit=unfit,
+        env_record={"gymnasium_id": spec.id, "entry_point": entry_point,
+                    "kwargs": _jsonable(spec.kwargs), "max_episode_steps": spec.max_episode_steps,
+                    "reward_threshold": spec.reward_threshold, "actions_rescaled_to": [-1, 1] if rescale else None,
+                    "observations_one_hot": one_hot_obs},
+    )
+
+
+def _jsonable(kwargs: dict) -> dict:
+    import json
+
+    out = {}
+    for key, value in (kwargs or {}).items():
+        try:
+            json.dumps(value)
+        except TypeError:
+            continue  # a callable or an object: the env's own registration supplies it
+        out[key] = value
+    return out

@@ -1,1 +1,0 @@
-"""Training loops, one per algorithm family, sharing :mod:`rlcore.trainers.session`."""

@@ -1,0 +1,48 @@
+"""The generated tables read what the model folders hold: a model trained ``--init-from`` another gives
+what the whole chain cost, and the CSV columns are those of every shipped file, not the first one's."""
+from __future__ import annotations
+
+from tools.docgen import data as docgen_data
+from tools.docgen import reference as docgen_reference
+from tools.docgen import regions as docgen
+
+
+def _model(tmp_path, name, meta, header=None):
+    folder = tmp_path / "saved_networks" / "mario_ppo" / name
+    folder.mkdir(parents=True)
+    if header:
+        (folder / "rollouts.csv").write_text(header + "\n")
+    return docgen_data.Model("mario_ppo", name, f"saved_networks/mario_ppo/{name}",
+                             {"algo": "ppo", "kind": "ppo", "preset": "levels", "episodes": 10, **meta}, None)
+
+
+def test_a_chain_of_init_from_runs_is_added_up_and_named(tmp_path, monkeypatch):
+    grandparent = {"path": "saved_networks/mario_ppo/2-1", "env_steps": 1_000, "wall_seconds": 3_600.0}
+    chained = _model(tmp_path, "1-3", {"env_steps": 300, "wall_seconds": 1_800.0, "init_from": {
+        "path": "saved_networks/mario_ppo/2-3", "env_steps": 200, "wall_seconds": 1_800.0, "init_from": grandparent}})
+    again = _model(tmp_path, "2-2", {"env_steps": 50, "wall_seconds": 360.0,
+                                     "init_from": {"path": "saved_networks/mario_ppo/2-2/", "env_steps": 50,
+                                                   "wall_seconds": 360.0}})
+    alone = _model(tmp_path, "1-2", {"env_steps": 70, "wall_seconds": 36.0})
+    assert [p["path"] for p in chained.lineage] == ["saved_networks/mario_ppo/2-3", "saved_networks/mario_ppo/2-1"]
+    assert chained.from_scratch() == (1_500, 7_200.0) and alone.lineage == [] and alone.from_scratch() == (70, 36.0)
+    monkeypatch.setattr(docgen, "shipped_models", lambda: [chained, again, alone])
+    monkeypatch.setattr(docgen, "card_path", lambda m, page: f"{m.name}.md")
+    text = docgen.region_shipped("docs/x.md", "mario_ppo")
+    assert "| 300 | 10 | 1,800 s | 1,500, 2.0 h (from 2-3, 2-1) |" in text
+    assert "| 50 | 10 | 360 s | 100, 720 s (from an earlier 2-2) |" in text
+    assert "| 70 | 10 | 36 s | – |" in text
+    monkeypatch.setattr(docgen, "shipped_models", lambda: [alone])  # no chain: no column
+    assert "started from" not in docgen.region_shipped("docs/x.md", "mario_ppo")
+
+
+def test_csv_columns_are_those_of_every_file(tmp_path, monkeypatch):
+    old = _model(tmp_path, "1-2", {}, "rollout,env_steps,loss")
+    new = _model(tmp_path, "1-1", {}, "rollout,env_steps,loss,lr")
+    monkeypatch.setattr(docgen_reference, "REPO", tmp_path)
+    monkeypatch.setattr(docgen_reference, "shipped_models", lambda: [old, new])
+    text = docgen_reference.region_csv_columns("docs/x.md", "mario_ppo")
+    assert "| `rollouts.csv` | mario_ppo | ppo | `rollout`, `env_steps`, `loss`, `lr`* |" in text
+    assert "in some of the shipped models' files only" in text
+    monkeypatch.setattr(docgen_reference, "shipped_models", lambda: [new])
+    assert "*" not in docgen_reference.region_csv_columns("docs/x.md", "mario_ppo").replace("`", "")

@@ -1,0 +1,1 @@
+"""Scripts that drive the package from a checkout (the docs generator); not installed with it."""

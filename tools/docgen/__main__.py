@@ -1,0 +1,5 @@
+import sys
+
+from tools.docgen.main import main
+
+sys.exit(main())
