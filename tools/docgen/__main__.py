@@ -1,5 +1,4 @@
-import sys
-
+"""``python -m tools.docgen [--check]``: see :mod:`tools.docgen.main`."""
 from tools.docgen.main import main
 
-sys.exit(main())
+raise SystemExit(main())
