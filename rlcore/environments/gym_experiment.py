@@ -102,12 +102,42 @@ def make_gym_env(render_mode: str | None = None, max_episode_steps: int | None =
     module, env_id = split_module(name)
     if module is not None:
         importlib.import_module(module)  # a spawned pool worker registers the user's env here
-    env = gym.make(env_id, render_mode=render_mode, max_episode_steps=max_episode_steps)
+    env = _make(env_id, render_mode, max_episode_steps)
     if isinstance(env.observation_space, gym.spaces.Discrete):
         env = OneHotObservation(env)
     if rescale_actions:
         env = gym.wrappers.RescaleAction(env, np.float32(-1.0), np.float32(1.0))
     return env
+
+
+def _make(env_id: str, render_mode: str | None, max_episode_steps: int | None) -> gymnasium.Env:
+    """``gym.make``, given ``render_mode`` only when frames are wanted (an env class may take no such
+    argument, as many tutorials write them), and only a mode the env declares; else one line."""
+    import gymnasium as gym
+
+    if render_mode is None:
+        return gym.make(env_id, max_episode_steps=max_episode_steps)
+    modes = _declared_modes(env_id)
+    if modes is not None and render_mode not in modes:
+        raise UserError(f"{env_id} cannot render {render_mode} frames: its env declares "
+                        f"{', '.join(modes) or 'no render mode'} (metadata['render_modes']), so there is no "
+                        "video or GIF of it; evaluate works without frames")
+    try:
+        return gym.make(env_id, max_episode_steps=max_episode_steps, render_mode=render_mode)
+    except TypeError as exc:
+        raise UserError(f"{env_id} cannot render: its env class takes no render_mode argument ({exc})") from None
+
+
+def _declared_modes(env_id: str) -> list[str] | None:
+    """The render modes the env's class declares (its ``metadata``), read without building it; None when
+    its entry point is a function that declares nothing (then only trying tells)."""
+    import gymnasium as gym
+    from gymnasium.envs.registration import load_env_creator
+
+    entry_point = gym.spec(env_id).entry_point
+    creator = load_env_creator(entry_point) if isinstance(entry_point, str) else entry_point
+    metadata = getattr(creator, "metadata", None)
+    return list(metadata.get("render_modes", [])) if isinstance(metadata, dict) else None
 
 
 def one_hot(observation: int, space: gymnasium.spaces.Discrete) -> np.ndarray:

@@ -76,6 +76,9 @@ class TrainingSession:
             if dropped:
                 print("resume: dropped rows logged after the checkpoint ("
                       + ", ".join(f"{n} from {name}" for name, n in dropped.items()) + ")", file=sys.stderr)
+            if damaged := self.tracker.damaged_rows:
+                print("resume: dropped damaged rows (not text, or cells missing: a disk error or a bad copy) ("
+                      + ", ".join(f"{n} from {name}" for name, n in damaged.items()) + ")", file=sys.stderr)
         self.progress = Progress(progress_unit, cfg, self.book.episodes, self.env_steps, spec.progress)
 
     # ------------------------------------------------------------ the loop's calls

@@ -16,6 +16,7 @@ from pathlib import Path
 
 from rlcore.errors import UserError, WriteFailed
 from rlcore.files.atomic import atomic_path
+from rlcore.files.csv_tables import read_table
 from rlcore.hyperparams.allowed import setting
 
 WANDB_MODES = ("auto", "online", "offline", "off")
@@ -61,11 +62,10 @@ def wandb_row(row: dict, table: str) -> dict:
 def _widen_header(path: Path, names: list[str]) -> list[str]:
     """The header of the CSV table at ``path``, with any of ``names`` it lacks appended (the file is
     rewritten atomically; older rows get empty cells there)."""
-    with open(path, newline="") as f:
-        rows = list(csv.reader(f))
+    rows, damaged = read_table(path)
     header = rows[0]
     new = [name for name in names if name not in header]
-    if new:
+    if new or damaged:
         with atomic_path(path) as tmp, open(tmp, "w", newline="") as f:
             csv.writer(f).writerows([header + new] + [r + [""] * len(new) for r in rows[1:]])
     return header + new
@@ -85,6 +85,7 @@ class Tracker:
         self.run_dir.mkdir(parents=True, exist_ok=True)
         self.csv_path = self.run_dir / "metrics.csv"
         self._tables: dict[str, tuple] = {}  # table name -> (binary file, its column names)
+        self.damaged_rows: dict[str, int] = {}  # table -> damaged rows the last resume left out
         self.wandb_run = None
         mode = resolve_wandb_mode(wandb_mode)
         if mode != "disabled":
@@ -126,20 +127,24 @@ class Tracker:
 
         A run killed between two checkpoints has logged episodes its checkpoint does not hold;
         the resumed run plays them again, so their first rows go. Every CSV table of the run with an
-        ``env_steps`` column is rewritten atomically. Returns {file name: rows dropped}.
+        ``env_steps`` column is rewritten atomically, its damaged rows left out too (counted in
+        ``damaged_rows``). Returns {file name: rows dropped}.
         """
-        dropped = {}
+        dropped, damaged_rows = {}, {}
         for path in sorted(self.run_dir.glob("*.csv")):
-            with open(path, newline="") as f:
-                rows = list(csv.reader(f))
+            rows, damaged = read_table(path)
             if not rows or "env_steps" not in rows[0]:
                 continue
             col = rows[0].index("env_steps")
-            kept = [rows[0]] + [r for r in rows[1:] if len(r) > col and float(r[col]) <= env_steps]
+            kept = [rows[0]] + [r for r in rows[1:] if float(r[col]) <= env_steps]
             if len(kept) < len(rows):
                 dropped[path.name] = len(rows) - len(kept)
+            if damaged:
+                damaged_rows[path.name] = damaged
+            if len(kept) < len(rows) or damaged:
                 with atomic_path(path) as tmp, open(tmp, "w", newline="") as f:
                     csv.writer(f).writerows(kept)
+        self.damaged_rows = damaged_rows
         return dropped
 
     def table_path(self, table: str) -> Path:
