@@ -12,12 +12,30 @@ class WriteFailed(UserError):
     """A file could not be written (a full disk, a read-only or unwritable folder). The file it would
     have replaced is untouched, and no temporary file is left behind."""
 
-    def __init__(self, path, exc: OSError):
+    def __init__(self, path, exc: OSError, then: str = "resume the run"):
         import errno
 
-        what = {errno.ENOSPC: "the disk is full: free some space (or write elsewhere), then resume the run",
-                errno.EDQUOT: "the disk quota is used up: free some space, then resume the run",
+        what = {errno.ENOSPC: f"the disk is full: free some space (or write elsewhere), then {then}",
+                errno.EDQUOT: f"the disk quota is used up: free some space, then {then}",
                 errno.EROFS: "the file system is read-only: write elsewhere",
-                errno.EACCES: "no permission to write there: write elsewhere"}.get(exc.errno, "check the disk and the folder, then resume the run")
+                errno.EACCES: "no permission to write there: write elsewhere"}.get(exc.errno, f"check the disk and the folder, then {then}")
         super().__init__(f"cannot write {path}: {exc.strerror or exc}; {what}")
         self.errno = exc.errno
+
+
+def disk_error(exc: BaseException) -> OSError | None:
+    """The OS error behind a library's failed write (TensorFlow's ResourceExhaustedError on a full disk,
+    a converter's message that quotes the OS), or None when ``exc`` is no disk error."""
+    import errno
+    import os
+
+    if isinstance(exc, OSError):
+        return exc
+    text = f"{type(exc).__name__}: {exc}"
+    for code, words in ((errno.ENOSPC, "No space left"), (errno.EROFS, "Read-only file system"),
+                        (errno.EDQUOT, "Disk quota exceeded"), (errno.EACCES, "Permission denied")):
+        if words in text:
+            return OSError(code, os.strerror(code))
+    if type(exc).__name__ == "ResourceExhaustedError":  # TensorFlow's writers on a full disk
+        return OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+    return None

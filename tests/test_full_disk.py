@@ -84,3 +84,24 @@ def test_a_read_only_disk_is_one_clear_error_and_the_run_resumes_once_writable(s
 def test_write_failed_names_the_path_and_what_to_do(tmp_path):
     error = WriteFailed(tmp_path / "x.npz", OSError(errno.ENOSPC, os.strerror(errno.ENOSPC)))
     assert str(error).startswith(f"cannot write {tmp_path}/x.npz: No space left on device; the disk is full")
+
+
+@pytest.mark.parametrize("fmt", ["savedmodel", "tflite", "onnx"])
+def test_an_export_onto_a_full_disk_is_one_line_and_an_earlier_export_stays_whole(small_disk, capfd, fmt):
+    """TensorFlow's SavedModel writer, the TFLite converter and tf2onnx raise their own errors on a full
+    disk (ResourceExhaustedError ...): each is the one WriteFailed line, into a new folder or over an
+    earlier export, which stays as it was."""
+    earlier = small_disk / "earlier"
+    code, _, err = run(capfd, "export", "lunar_lander", "dqn", "--format", fmt, "--out", str(earlier))
+    assert code == 0, err
+    before = {p.relative_to(earlier): p.read_bytes() for p in earlier.rglob("*") if p.is_file()}
+    filler = fill(small_disk, 0)
+    for out in (small_disk / "new", earlier):
+        code, _, err = run(capfd, "export", "lunar_lander", "dqn", "--format", fmt, "--out", str(out))
+        lines = err.strip().splitlines()
+        assert code == 2 and len(lines) == 1 and lines[0].startswith(f"error: cannot write {out}"), lines
+        assert "No space left on device" in lines[0] and "then export again" in lines[0]
+        assert not (small_disk / "new").exists()
+        assert {p.relative_to(earlier): p.read_bytes() for p in earlier.rglob("*") if p.is_file()} == before
+        assert not [p for p in small_disk.iterdir() if p.name.startswith(".")], "a temporary folder was left"
+    filler.unlink()

@@ -18,6 +18,7 @@ written in a temporary folder and moved into place only once the check has passe
 """
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import shutil
@@ -29,7 +30,7 @@ from typing import Callable
 import numpy as np
 
 from rlcore.algorithms.registry import family
-from rlcore.errors import UserError
+from rlcore.errors import UserError, WriteFailed, disk_error
 from rlcore.hyperparams.allowed import flag, setting
 from rlcore.models.export_parity import (
     ABS_TOLERANCE,
@@ -77,11 +78,13 @@ def export_model(model_dir: str | os.PathLike, fmt: str, out_dir: str | os.PathL
         obs, seeds = collect_observations(exp, policy, int(observations), episodes)
     reference = _outputs(acting, obs)
 
-    out_dir.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", dir=out_dir.parent))
+    with written(out_dir):
+        out_dir.parent.mkdir(parents=True, exist_ok=True)
+        tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", dir=out_dir.parent))
     try:
         path = tmp / FILES[fmt]
-        converter = WRITERS[fmt](acting, path)
+        with written(out_dir):  # TensorFlow's, LiteRT's and tf2onnx's writers on a full or read-only disk
+            converter = WRITERS[fmt](acting, path)
         exported = runtime.run(path, obs)
         parity = compare(acts.discrete, reference, exported)
         if as_trained is not None:  # a bfloat16 model is exported in float32: how far that moved it
@@ -107,12 +110,13 @@ def export_model(model_dir: str | os.PathLike, fmt: str, out_dir: str | os.PathL
             "versions": versions(fmt),
             "created": datetime.now(timezone.utc).isoformat(timespec="seconds"),
         }
-        (tmp / "export.json").write_text(json.dumps(record, indent=2) + "\n")
         if not parity["passed"]:
             raise ParityError(f"{fmt} export of {source or model_dir} failed its parity check: "
                               + summary(record) + f"; nothing written to {out_dir}")
-        os.chmod(tmp, 0o777 & ~_umask())  # mkdtemp makes 0700
-        _move_into_place(tmp, out_dir)
+        with written(out_dir):
+            (tmp / "export.json").write_text(json.dumps(record, indent=2) + "\n")
+            os.chmod(tmp, 0o777 & ~_umask())  # mkdtemp makes 0700
+            _move_into_place(tmp, out_dir)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     return record
@@ -208,6 +212,19 @@ def _check_out(out_dir: Path) -> None:
     from rlcore.files.atomic import writable_folder
 
     writable_folder(out_dir.parent, flag("out"))
+
+
+@contextlib.contextmanager
+def written(out_dir: Path):
+    """A failed write under ``out_dir`` (ours or a library's) as one line naming it; an earlier export there
+    is left whole (the new one is written beside it and moved in only when complete)."""
+    try:
+        yield
+    except Exception as exc:  # noqa: BLE001 (a library's own error type, turned into the OS error behind it)
+        reason = disk_error(exc)
+        if reason is None or isinstance(exc, UserError):
+            raise
+        raise WriteFailed(out_dir, reason, then="export again") from None
 
 
 def _move_into_place(tmp: Path, out_dir: Path) -> None:
