@@ -132,6 +132,18 @@ def test_the_same_flags_with_what_they_need_are_accepted():
         check_no_inert(apply_overrides(mario, given), given)
 
 
+def test_a_run_ended_by_its_step_budget_names_the_budget_to_raise(capsys, tmp_path):
+    """Issue 65: `--resume RUN --episodes N` of a run that ended at its --steps budget was told to give a
+    larger budget (--episodes or --steps), though a larger --episodes was given; the line names --steps."""
+    run_dir = tmp_path / "run"
+    quiet = ["--final-eval-episodes", "0", "--wandb", "off", "--no-progress"]
+    code, out, err = run(capsys, "train", "cartpole", "dqn", "--steps", "40", *quiet, "--run-dir", str(run_dir))
+    assert code == 0, err
+    code, out, err = run(capsys, "train", "cartpole", "dqn", "--resume", str(run_dir), "--episodes", "500", *quiet)
+    assert code == 2 and "(--max-env-steps 40," in err
+    assert err.strip().endswith("give a larger --steps (a larger --episodes alone does not lift a step budget)")
+
+
 def test_a_finished_run_resumed_with_nothing_left_to_train_is_refused_and_left_as_it_was(capsys, tmp_path):
     """A new user's `--resume RUN --episodes 2` of a run finished at 3 episodes trained nothing, evaluated
     again and recorded a resume that did nothing; now one line, exit 2, files untouched. A larger budget
@@ -148,7 +160,7 @@ def test_a_finished_run_resumed_with_nothing_left_to_train_is_refused_and_left_a
         assert code == 2, (budget, out, err)
         assert err.strip().startswith(f"error: nothing to train: the run in {run_dir} is finished, and what ended it "
                                       f"still holds (--max-episodes ")
-        assert err.strip().endswith("give a larger budget (--episodes or --steps) or change that setting")
+        assert err.strip().endswith("; give a larger --episodes")
     after = {p.name: p.read_bytes() for p in (run_dir / "model").iterdir()} | {
         p.name: p.read_bytes() for p in run_dir.iterdir() if p.is_file() and p.name != ".lock"}
     assert after == before

@@ -103,9 +103,12 @@ def refuse_nothing_to_train(spec: RunSpec, state: dict) -> None:
     ended = StopRules(cfg).reason(book, env_steps, PeriodicEvaluation(cfg, state))
     if ended:
         field, _, value = ended.partition(" ")
+        budget = {"max_episodes": "episodes", "max_env_steps": "steps"}.get(field)
+        what = (f"give a larger {flag(budget)}" + (" (a larger --episodes alone does not lift a step budget)"
+                                                    if budget == "steps" else "")
+                if budget else f"change {flag(field)}")
         raise UserError(f"nothing to train: the run in {spec.run_dir} is finished, and what ended it still holds "
-                        f"({flag(field)} {value}, at episode {episodes:,}, env step {env_steps:,}); give a larger "
-                        f"budget ({flag('episodes')} or {flag('steps')}) or change that setting")
+                        f"({flag(field)} {value}, at episode {episodes:,}, env step {env_steps:,}); {what}")
 
 
 def run_training(spec: RunSpec, on_progress: Callable[[dict, str], None] | None = None) -> Path:

@@ -84,7 +84,7 @@ def test_pace_reads_only_the_rows_since_a_counter_went_back_and_never_says_nan(t
     table = tmp_path / "metrics.csv"
     # an older run's rows, then a clock that starts again: 100 env steps a second since, not 1,700
     table.write_text("episode,env_steps,wall_seconds\n1,1000,10\n2,2000,20\n3,2100,1\n4,3000,10\n")
-    assert pace(table, about) == pytest.approx((100.0, 30.0))  # floats read back and divided: not held to the bit
+    assert pace(table, about)[:2] == pytest.approx((100.0, 30.0))  # floats read back and divided: not held to the bit
     table.write_text("episode,env_steps,wall_seconds\n1,1000,10\n2,2000,\n")  # the last clock reading missing
     assert pace(table, about) is None
     table.write_text("episode,env_steps,wall_seconds\n1,1000,10\n2,1000,20\n")  # no step taken
@@ -99,15 +99,15 @@ def test_the_hours_left_are_read_from_the_pace_of_learning_not_of_the_random_fir
     # 200 env steps a second before the first gradient step, 100 since: 6,000 left at 100 a second
     table.write_text("episode,env_steps,wall_seconds,grad_steps\n1,1000,5,0\n2,2000,10,0\n3,3000,20,1000\n"
                      "4,4000,30,2000\n")
-    assert pace(table, about) == pytest.approx((100.0, 60.0))
+    assert pace(table, about)[:2] == pytest.approx((100.0, 60.0))
     table.write_text("episode,env_steps,wall_seconds,grad_steps\n1,1000,5,0\n2,2000,10,0\n")  # none yet
-    assert pace(table, about) == pytest.approx((200.0, None))
+    assert pace(table, about)[:2] == pytest.approx((200.0, None))
     table.write_text("episode,env_steps,wall_seconds,grad_steps\n1,1000,10,5\n2,2000,20,10\n")  # from the start
-    assert pace(table, about) == pytest.approx((100.0, 60.0))
+    assert pace(table, about)[:2] == pytest.approx((100.0, 60.0))
     # a resume that refills an empty memory (no gradient step, the count stays) and learns again
     table.write_text("episode,env_steps,wall_seconds,grad_steps\n1,1000,10,5\n2,2000,20,10\n3,3000,25,10\n"
                      "4,4000,35,20\n")
-    assert pace(table, about) == pytest.approx((100.0, 60.0))
+    assert pace(table, about)[:2] == pytest.approx((100.0, 60.0))
     table.write_text("episode,env_steps,wall_seconds,grad_steps\n1,1000,10,5\n2,2000,20,10\n3,3000,25,10\n")
     assert pace(table, about)[1] is None  # refilling now: no hours told from it
 
@@ -146,3 +146,18 @@ def test_the_sweeps_hours_left_are_never_fewer_than_its_longest_trials():
     assert time_left([NotLearning(7200)], [], 3600, 1) == []  # no finished trial to take a pace from
     assert time_left([None, 3600.0], [], None, 1) == []  # a trial whose pace cannot be told
     assert time_left([NOT_STARTED], [], 1000, 1) == []  # no finished trial to take a pace from
+
+
+def test_an_episode_budget_gives_the_hours_left_too(tmp_path):
+    """Issue 65: status gave the hours left only for an env-step budget. 10 episodes of 100 steps in 100 s
+    (0.1 episode/s): 90 of a 100-episode budget left is 900 s; with both budgets, the one met first."""
+    from rlcore.runs.pace import pace, pace_text
+
+    table = tmp_path / "metrics.csv"
+    table.write_text("episode,env_steps,wall_seconds\n" + "".join(f"{i},{100 * i},{10 * i}\n" for i in range(1, 11)))
+    about = {"env_steps": 1000, "returns": [0.0] * 10, "config": {"max_episodes": 100, "max_env_steps": 0}}
+    rate, left, budget = pace(table, about)
+    assert (rate, budget) == (pytest.approx(10.0), "100 episodes") and left == pytest.approx(900.0)
+    assert pace_text(table, about).endswith("about 0.2 h to its budget of 100 episodes")
+    about["config"]["max_env_steps"] = 2000  # 1,000 steps left at 10/s: 100 s, before the episodes
+    assert pace(table, about)[1:] == (pytest.approx(100.0), "2,000 env steps")

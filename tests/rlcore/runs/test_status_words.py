@@ -49,9 +49,9 @@ def test_the_hours_left_to_a_budget_say_a_stop_rule_may_end_the_run_sooner():
     budget are an upper bound, and the line says so."""
     from pathlib import Path
 
-    from rlcore.runs.pace import pace_text
+    from rlcore.runs.pace import Pace, pace_text
 
-    measured = (53.0, 25.5 * 3600)
+    measured = Pace(53.0, 25.5 * 3600, "6,000,000 env steps")
     text = pace_text(Path("unread.csv"), {"config": {"max_env_steps": 6_000_000, "stop_success_share": 0.9}}, measured)
     assert text == ("53 env steps/s lately, about 25.5 h to its budget of 6,000,000 env steps "
                     "(its stop rule may end it sooner)")
