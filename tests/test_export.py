@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 import main
-from rlcore.errors import UserError
 from rlcore.algorithms.registry import family
+from rlcore.errors import UserError
 from rlcore.models import export
 from rlcore.models.export_parity import ABS_TOLERANCE, REL_TOLERANCE, ParityError, collect_observations
 from rlcore.models.policies import load_policy

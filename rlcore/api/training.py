@@ -23,7 +23,8 @@ WandbMode = Literal["auto", "online", "offline", "off"]
 def train(env: str, algo: str, *, preset: str | None = None, seed: int = 0,
           run_dir: str | os.PathLike[str] | None = None, episodes: int | None = None,
           steps: int | None = None, final_eval_episodes: int | None = None, wandb: WandbMode = "off",
-          progress: bool = True, callback: ProgressCallback | None = None, **hyperparameters: Any) -> Run:
+          progress: bool = True, callback: ProgressCallback | None = None, env_kwargs: dict[str, Any] | None = None,
+          **hyperparameters: Any) -> Run:
     """Train ``algo`` on ``env`` and evaluate it as ``main.py train`` does; return the :class:`Run`.
 
     ``env``: an experiment of this package (``"lunar_lander"``), any registered Gymnasium id whose
@@ -32,7 +33,8 @@ def train(env: str, algo: str, *, preset: str | None = None, seed: int = 0,
     Gymnasium id the algorithm's defaults). ``episodes`` / ``steps``: the budget (``max_episodes`` /
     ``max_env_steps``). ``final_eval_episodes``: episodes on unseen seeds after training (None: the
     experiment's default, 100; 0: none). ``run_dir``: where the run writes (default
-    ``runs/ENV__ALGO__SEED__TIME``). ``hyperparameters``: any field of the algorithm's config, e.g.
+    ``runs/ENV__ALGO__SEED__TIME``). ``env_kwargs``: a Gymnasium id's constructor arguments
+    (``{"continuous": True}``), checked and recorded as ``--env-kwargs``. ``hyperparameters``: any field of the algorithm's config, e.g.
     ``lr=5e-4, hidden=(128, 128)``; each is checked as the CLI checks it. ``callback(row, table)``
     sees every logged row. ``progress``: the progress bar and the summary lines.
     """
@@ -50,9 +52,11 @@ def train(env: str, algo: str, *, preset: str | None = None, seed: int = 0,
     check_new_run_dir(folder)
     command = _call("train", [env, algo], dict(preset=preset, seed=seed, run_dir=run_dir, episodes=episodes,
                                                  steps=steps, final_eval_episodes=final_eval_episodes,
+                                                 **({"env_kwargs": env_kwargs} if env_kwargs else {}),
                                                  **hyperparameters))
     spec = build_spec(env, algo, preset=preset, seed=seed, overrides=overrides, run_dir=folder,
-                      wandb_mode=wandb, progress=progress, command=command, final_eval_episodes=final_eval_episodes)
+                      wandb_mode=wandb, progress=progress, command=command, final_eval_episodes=final_eval_episodes,
+                      env_kwargs=env_kwargs)
     return _train_and_evaluate(spec, f"training {env} {algo} ({spec.preset} preset, seed {spec.seed}) -> {folder}",
                                callback, progress)
 

@@ -59,7 +59,7 @@ def _spec_from_args(args):
     overrides = {**given, **_budget_overrides(args, given)}
     common = dict(preset=args.preset, seed=args.seed, overrides=overrides, wandb_mode=args.wandb,
                   progress=not args.no_progress, command=getattr(args, "command_line", None),
-                  final_eval_episodes=args.final_eval_episodes)
+                  final_eval_episodes=args.final_eval_episodes, env_kwargs=args.env_kwargs)
     if args.resume is not None:
         run_dir = latest_run_dir(args.experiment, args.algo) if args.resume == "latest" else Path(args.resume)
         spec = build_spec(args.experiment, args.algo, run_dir=run_dir, resume=True,

@@ -28,10 +28,12 @@ def _flags(names) -> str:
 def _model_dir(args) -> Path:
     """--model, else the shipped model (where an experiment ships one per value of some fields, that of
     the values given: Mario's --world/--stage, default 1-1)."""
+    from rlcore.environments.gym_experiment import algorithms
     from rlcore.environments.registry import get_experiment
 
     exp = get_experiment(args.experiment)
-    exp.algo(args.algo)  # unknown names -> clear error
+    if not (args.model and exp.env_record and args.algo in algorithms()):
+        exp.algo(args.algo)  # unknown names -> clear error; a model's own env (--env-kwargs) is read from it
     given = _shipped_choice(args)
     if not given and args.model:
         folder = Path(args.model)

@@ -11,6 +11,7 @@ import functools
 
 from rlcore.cli.parser_class import CommandParser, QuietParser, Unparsable
 from rlcore.environments.seeding import MAX_RUN_SEED
+from rlcore.errors import UserError
 from rlcore.hyperparams import allowed
 from rlcore.hyperparams.allowed import Allowed, whole_number
 from rlcore.hyperparams.limits import EVAL_COUNT, FINAL_EVALUATION, FRAME_RATE, RUN_SEEDS
@@ -64,6 +65,16 @@ def _algorithms_by_experiment() -> str:
     from rlcore.environments.registry import experiment_names, get_experiment
 
     return "; ".join(f"{name}: {', '.join(get_experiment(name).algos)}" for name in experiment_names())
+
+
+def env_kwargs_value(text: str) -> dict:
+    """``--env-kwargs``'s value: a bad one is argparse's one line and exit status 2."""
+    from rlcore.environments.env_kwargs import parse_env_kwargs
+
+    try:
+        return parse_env_kwargs(text)
+    except UserError as exc:
+        raise argparse.ArgumentTypeError(str(exc).removeprefix("--env-kwargs").lstrip(": ")) from None
 
 
 def build_parser(argv: list[str], prog: str | None = None) -> argparse.ArgumentParser:
@@ -125,6 +136,10 @@ def _add_train(sub, prog: str, episodes: str, argv: list[str]) -> None:
                        help="copy the trained model into saved_networks/EXPERIMENT/ALGO/, replacing the "
                             "shipped one, if its evaluation on unseen seeds meets that model's bar")
     train.add_argument("--no-progress", action="store_true", help="no progress bar")
+    train.add_argument("--env-kwargs", type=env_kwargs_value, default=None, metavar="KWARGS",
+                       help="a Gymnasium id's constructor arguments, as key=value pairs or a JSON object "
+                            "(continuous=True for LunarLander-v3, to train SAC); each is checked against the "
+                            "env's parameters and recorded, so evaluate, render and export rebuild the env")
     _add_hyperparameters(train, argv)
 
 
@@ -203,6 +218,8 @@ def _add_sweep(sub, episodes: str) -> None:
     sweep.add_argument("--grid", action="append", default=[], metavar="NAME=V1,V2",
                        help="a hyperparameter and its values (repeatable), e.g. --grid lr=1e-4,3e-4")
     sweep.add_argument("--preset", default=None, help=PRESET_HELP)
+    sweep.add_argument("--env-kwargs", type=env_kwargs_value, default=None, metavar="KWARGS",
+                       help="a Gymnasium id's constructor arguments for every trial, as train's --env-kwargs")
     sweep.add_argument("--episodes", type=COUNT, default=None, help="episode budget of each run (as train's --episodes: A2C and PPO "
                        "check it after each rollout)")
     sweep.add_argument("--steps", type=COUNT, default=None, help="env step budget of each run (as train's --steps: it ends at the end of the "
@@ -363,4 +380,22 @@ def _add_hyperparameters(train: argparse.ArgumentParser, argv: list[str]) -> Non
     from rlcore.environments.registry import get_experiment
     from rlcore.hyperparams.flags import add_arguments
 
-    add_arguments(train, get_experiment(names.experiment).preset(names.algo, names.preset))
+    given = env_kwargs_value(names.env_kwargs) if names.env_kwargs else None
+    recorded = _recorded_env(names.resume)  # a resume's flags are its run's (a change is refused later)
+    experiment = get_experiment(names.experiment, recorded, env_kwargs=None if recorded else given)
+    add_arguments(train, experiment.preset(names.algo, names.preset))
+
+
+def _recorded_env(resume: str | None) -> dict | None:
+    """The env a resumed run records (a Gymnasium id's --env-kwargs among it), read quietly: a missing or
+    damaged checkpoint is the resume's own error to report."""
+    if not resume or resume == "latest":
+        return None
+    from pathlib import Path
+
+    from rlcore.files.checkpoint import read_checkpoint_state
+
+    try:
+        return read_checkpoint_state(Path(resume) / "checkpoint.npz").get("env") or None
+    except (UserError, OSError, ValueError):
+        return None

@@ -61,12 +61,14 @@ def cmd_sweep(args) -> int:
     from rlcore.training.run import budget_overrides
 
     require("ray.tune", "The sweep command")  # the sweep extra, or one line saying so
-    exp = get_experiment(args.experiment)
+    exp = get_experiment(args.experiment, env_kwargs=args.env_kwargs)
     base = exp.preset(args.algo, args.preset)
     name = args.name or f"{args.experiment}__{args.algo}"
     folder = (Path(args.dir) / name).resolve()
     if args.resume:
         sweep = Sweep.load(folder)
+        if args.env_kwargs is not None and args.env_kwargs != (sweep.env_kwargs or {}):
+            raise UserError(f"--env-kwargs cannot change on a resume: sweep {name} runs with {sweep.env_kwargs or 'none'}")
         if (sweep.experiment, sweep.algo) != (args.experiment, args.algo):
             raise UserError(f"sweep {name} runs {sweep.experiment} {sweep.algo}, "
                             f"not {args.experiment} {args.algo}")
@@ -75,7 +77,7 @@ def cmd_sweep(args) -> int:
             raise UserError(f"sweep {name} exists in {folder}; continue it with --resume or pick another --name")
         sweep = Sweep(args.experiment, args.algo, name, str(folder), parse_seeds(args.seeds),
                       parse_grid(args.grid, base), args.preset, budget_overrides(args.episodes, args.steps), args.cpus_per_run,
-                      args.max_concurrent, args.final_eval_episodes)
+                      args.max_concurrent, args.final_eval_episodes, args.env_kwargs)
     trials = sweep.trials()
     print(f"sweep {name}: {len(trials)} trials of {sweep.experiment} {sweep.algo} -> {folder}/")
     rows = run_sweep(sweep, address=args.address, num_cpus=args.num_cpus)

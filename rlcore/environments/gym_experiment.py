@@ -23,6 +23,7 @@ and the env pool in-process. Every field stays a flag (``--lr 3e-4``) or a keywo
 from __future__ import annotations
 
 import importlib
+import json
 import re
 from functools import partial
 from typing import TYPE_CHECKING
@@ -94,15 +95,16 @@ def register_from_record(record: dict) -> None:
 
 
 def make_gym_env(render_mode: str | None = None, max_episode_steps: int | None = None, *, name: str,
-                 rescale_actions: bool = False) -> gymnasium.Env:
+                 rescale_actions: bool = False, env_kwargs: dict | None = None) -> gymnasium.Env:
     """The env ``name`` (``module:id`` imports the module first) with its registered time limit unless
-    ``max_episode_steps`` is given; SAC's envs get their Box actions rescaled from [-1, 1]."""
+    ``max_episode_steps`` is given, built with ``env_kwargs`` (``--env-kwargs``); SAC's envs get their Box
+    actions rescaled from [-1, 1]."""
     import gymnasium as gym
 
     module, env_id = split_module(name)
     if module is not None:
         importlib.import_module(module)  # a spawned pool worker registers the user's env here
-    env = _make(env_id, render_mode, max_episode_steps)
+    env = _make(env_id, render_mode, max_episode_steps, env_kwargs or {})
     if isinstance(env.observation_space, gym.spaces.Discrete):
         env = OneHotObservation(env)
     if rescale_actions:
@@ -110,20 +112,20 @@ def make_gym_env(render_mode: str | None = None, max_episode_steps: int | None =
     return env
 
 
-def _make(env_id: str, render_mode: str | None, max_episode_steps: int | None) -> gymnasium.Env:
+def _make(env_id: str, render_mode: str | None, max_episode_steps: int | None, env_kwargs: dict) -> gymnasium.Env:
     """``gym.make``, given ``render_mode`` only when frames are wanted (an env class may take no such
     argument, as many tutorials write them), and only a mode the env declares; else one line."""
     import gymnasium as gym
 
     if render_mode is None:
-        return gym.make(env_id, max_episode_steps=max_episode_steps)
+        return gym.make(env_id, max_episode_steps=max_episode_steps, **env_kwargs)
     modes = _declared_modes(env_id)
     if modes is not None and render_mode not in modes:
         raise UserError(f"{env_id} cannot render {render_mode} frames: its env declares "
                         f"{', '.join(modes) or 'no render mode'} (metadata['render_modes']), so there is no "
                         "video or GIF of it; evaluate works without frames")
     try:
-        return gym.make(env_id, max_episode_steps=max_episode_steps, render_mode=render_mode)
+        return gym.make(env_id, max_episode_steps=max_episode_steps, render_mode=render_mode, **env_kwargs)
     except TypeError as exc:
         raise UserError(f"{env_id} cannot render: its env class takes no render_mode argument ({exc})") from None
 
@@ -179,21 +181,32 @@ def default_preset(kind: str, switches: dict, reward_threshold: float | None) ->
     return family(kind).config(**fields)
 
 
-def gym_experiment(name: str) -> Experiment:
-    """The :class:`Experiment` of the Gymnasium id ``name`` (``module:id`` allowed); an unknown id is
-    a :class:`UserError`. Built once per process and name."""
-    key = (name, tuple(FAMILIES))  # a family registered since is offered too
+def gym_experiment(name: str, env_kwargs: dict | None = None) -> Experiment:
+    """The :class:`Experiment` of the Gymnasium id ``name`` (``module:id`` allowed) built with ``env_kwargs``
+    (which may change its spaces, so the algorithms that fit); an unknown id is a :class:`UserError`. Built
+    once per process, name and arguments."""
+    env_kwargs = dict(env_kwargs or {})
+    key = (name, json.dumps(env_kwargs, sort_keys=True), tuple(FAMILIES))  # a family registered since is offered too
     if key not in _BUILT:
-        _BUILT[key] = _build(name)
+        _BUILT[key] = _build(name, env_kwargs)
     return _BUILT[key]
 
 
-_BUILT: dict[tuple[str, tuple[str, ...]], Experiment] = {}
+_BUILT: dict[tuple[str, str, tuple[str, ...]], Experiment] = {}
 
 
-def _build(name: str) -> Experiment:
+def _build(name: str, env_kwargs: dict) -> Experiment:
     spec = gym_spec(name)
-    env = make_gym_env(name=name)
+    if env_kwargs:
+        from rlcore.environments.env_kwargs import check_env_kwargs
+
+        check_env_kwargs(spec.id, env_kwargs)
+    try:
+        env = make_gym_env(name=name, env_kwargs=env_kwargs)
+    except (TypeError, ValueError, AssertionError) as exc:  # a value the env's own checks refuse
+        if not env_kwargs:
+            raise
+        raise UserError(f"--env-kwargs: {spec.id} refused {env_kwargs}: {exc}") from None
     try:
         obs_space, act_space = env.observation_space, env.action_space
         one_hot_obs = type(env.unwrapped.observation_space).__name__ == "Discrete"  # given one-hot
@@ -213,7 +226,7 @@ def _build(name: str) -> Experiment:
     return Experiment(
         name=name,
         description=f"Gymnasium {spec.id} (observations {obs_space}, actions {act_space})",
-        make_env=partial(make_gym_env, name=name, rescale_actions=rescale),
+        make_env=partial(make_gym_env, name=name, rescale_actions=rescale, env_kwargs=env_kwargs or None),
         algos=algos,
         solved_score=None if spec.reward_threshold is None else float(spec.reward_threshold),
         plot_prefix=re.sub(r"[^\w.-]", "_", spec.id),
@@ -222,7 +235,7 @@ def _build(name: str) -> Experiment:
         env_record={"gymnasium_id": spec.id, "entry_point": entry_point,
                     "kwargs": _jsonable(spec.kwargs), "max_episode_steps": spec.max_episode_steps,
                     "reward_threshold": spec.reward_threshold, "actions_rescaled_to": [-1, 1] if rescale else None,
-                    "observations_one_hot": one_hot_obs},
+                    "observations_one_hot": one_hot_obs, **({"env_kwargs": env_kwargs} if env_kwargs else {})},
     )
 
 

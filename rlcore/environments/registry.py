@@ -29,16 +29,20 @@ def eval_episodes_words() -> str:
     return "; ".join([f"default {default}"] + [f"{name} {n}" for name, n in counts.items() if n != default])
 
 
-def get_experiment(name: str, env_record: dict | None = None) -> Experiment:
+def get_experiment(name: str, env_record: dict | None = None, env_kwargs: dict | None = None) -> Experiment:
     """The experiment ``name``: a package's (``lunar_lander`` ...), else a registered Gymnasium id
     (``Acrobot-v1``, or ``my_envs:Maze-v0`` to import ``my_envs`` first; :mod:`rlcore.environments.gym_experiment`).
     ``env_record``: a model's recorded env (meta.json's ``env``), registered again if this process
-    lacks it."""
+    lacks it, and built with the arguments it records; ``env_kwargs``: a new run's ``--env-kwargs``."""
     if name in EXPERIMENT_MODULES:
+        if env_kwargs:
+            raise UserError(f"--env-kwargs is for a Gymnasium id; {name}'s env is set by its presets and "
+                            f"hyperparameters (`train {name} ALGO --help`)")
         return importlib.import_module(EXPERIMENT_MODULES[name]).EXPERIMENT
     if not gym_experiment.looks_like_gym_id(name):
         raise UserError(f"unknown experiment {name!r}; choose one of {', '.join(EXPERIMENT_MODULES)}, "
                         f"or a registered Gymnasium id such as CartPole-v1")
     if env_record:
         gym_experiment.register_from_record(env_record)
-    return gym_experiment.gym_experiment(name)
+        env_kwargs = env_kwargs or env_record.get("env_kwargs")
+    return gym_experiment.gym_experiment(name, env_kwargs)

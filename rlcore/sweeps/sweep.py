@@ -40,6 +40,7 @@ class Sweep:
     cpus_per_run: float = 1.0
     max_concurrent: int = 0  # 0 = as many as the CPUs allow
     final_eval_episodes: int | None = None  # None = the experiment's default
+    env_kwargs: dict | None = None  # a Gymnasium id's constructor arguments (--env-kwargs), every trial's
 
     def trials(self) -> list[dict]:
         """One dict per trial: the seed and one value of every grid field."""
@@ -139,7 +140,7 @@ def check(sweep: Sweep) -> None:
     from rlcore.environments.registry import get_experiment
     from rlcore.hyperparams.flags import apply_overrides, check_no_inert
 
-    exp = get_experiment(sweep.experiment)
+    exp = get_experiment(sweep.experiment, env_kwargs=sweep.env_kwargs)
     base = exp.preset(sweep.algo, sweep.preset)
     for trial in sweep.trials():
         values = {k: v for k, v in trial.items() if k != "seed"}

@@ -95,7 +95,8 @@ def _train_trial(trial: dict, sweep: Sweep, run_dir: Path, report) -> dict:
                f"(trial {trial_name(trial)}{', resumed' if resume else ''})")
     spec = build_spec(sweep.experiment, sweep.algo, preset=sweep.preset, seed=int(trial["seed"]),
                       overrides={**sweep.overrides, **values}, run_dir=run_dir, resume=resume,
-                      wandb_mode="off", progress=False, command=command)
+                      wandb_mode="off", progress=False, command=command,
+                      env_kwargs=None if resume else sweep.env_kwargs)
     spec.stop_file = Path(sweep.folder) / STOP_FILE
     last = [0.0]
 

@@ -22,22 +22,24 @@ from rlcore.environments.registry import get_experiment
 from rlcore.errors import UserError
 from rlcore.hyperparams.allowed import flag, resume_words, setting
 from rlcore.hyperparams.flags import apply_overrides, as_recorded, check_no_inert, check_same_run, from_dict, to_dict
-from rlcore.training.spec import RunSpec, check_resumable
+from rlcore.training.spec import CHECKPOINT_FILE, RunSpec, check_resumable
 
 
 def build_spec(experiment: str, algo: str, *, preset: str | None = None, seed: int | None = None,
                overrides: dict | None = None, run_dir: Path, resume: bool = False,
                wandb_mode: str | None = None, progress: bool = True, command: str | None = None,
-               nothing_to_train_ok: bool = False, final_eval_episodes: int | None = None) -> RunSpec:
+               nothing_to_train_ok: bool = False, final_eval_episodes: int | None = None,
+               env_kwargs: dict | None = None) -> RunSpec:
     """The :class:`RunSpec` of a new run (``resume=False``; ``seed`` None = 0) or of the run in
     ``run_dir``, whose seed, preset and defining fields a resume may not change, and which must have
     something left to train unless ``nothing_to_train_ok`` (``--publish``: evaluate it again, publish).
     ``wandb_mode`` and ``final_eval_episodes`` left None: ``auto`` and the experiment's default for a new
-    run, the run's own for a resume (its checkpoint records them)."""
+    run, the run's own for a resume (its checkpoint records them). ``env_kwargs``: a Gymnasium id's
+    constructor arguments (``--env-kwargs``); a resume keeps the run's."""
     from rlcore.files.run_lock import refuse_if_busy
 
     refuse_if_busy(run_dir)  # before the checkpoint is read or a header printed
-    exp = get_experiment(experiment)
+    exp = _experiment_of(experiment, Path(run_dir), resume, env_kwargs)
     overrides = dict(overrides or {})
     extra = {} if command is None else {"command": command}
     if resume:
@@ -77,6 +79,24 @@ def build_spec(experiment: str, algo: str, *, preset: str | None = None, seed: i
     seed = 0 if seed is None else seed
     return RunSpec(exp, algo, preset or exp.algo(algo).default_preset, config, seed, wandb_mode or "auto",
                    Path(run_dir), progress=progress, final_eval_episodes=final_eval_episodes, **extra)
+
+
+def _experiment_of(experiment: str, run_dir: Path, resume: bool, env_kwargs: dict | None):
+    """The run's experiment: for a resume, built with the env arguments its checkpoint records (which
+    ``--env-kwargs`` may repeat, not change)."""
+    if not resume:
+        return get_experiment(experiment, env_kwargs=env_kwargs)
+    from rlcore.files.checkpoint import read_checkpoint_state
+
+    try:
+        record = read_checkpoint_state(run_dir / CHECKPOINT_FILE).get("env") or {}
+    except (UserError, OSError):
+        record = {}  # a missing or damaged checkpoint: check_resumable says so in its words
+    recorded = record.get("env_kwargs") or {}
+    if env_kwargs is not None and env_kwargs != recorded:
+        raise UserError(f"--env-kwargs cannot change on a resume: the run in {run_dir} was started with "
+                        f"{recorded or 'none'}")
+    return get_experiment(experiment, record or None)
 
 
 def refuse_nothing_to_train(spec: RunSpec, state: dict) -> None:

@@ -9,8 +9,18 @@ from tools.docgen.data import REPO
 from tools.docgen.reference import region_bars
 from tools.docgen.regions import OVER_SEEDS_HEADER, experiment_page, region_shipped, region_sweeps
 from tools.docgen.sweeps import stop_text
-from tools.docgen.words import (article_of, bar_met, bar_text, fill, link, over_seeds, ret, score_text, sweep_score,
-                                table)
+from tools.docgen.words import (
+    article_of,
+    bar_met,
+    bar_text,
+    fill,
+    link,
+    over_seeds,
+    ret,
+    score_text,
+    sweep_score,
+    table,
+)
 
 #: what a model folder's file is, by its name or extension, or a plot by its kind (PREFIX_KIND_ALGO.png, as
 #: rlcore/runs/plotting.py names it)

@@ -6,8 +6,18 @@ import re
 from rlcore.runs.score_words import hours, success_word
 from tools.docgen import reference, sweeps
 from tools.docgen.data import REPO, shipped_models
-from tools.docgen.words import (article_of, bar_met, bar_text, interval, link, over_seeds, ret, score_text, sweep_score,
-                                table)
+from tools.docgen.words import (
+    article_of,
+    bar_met,
+    bar_text,
+    interval,
+    link,
+    over_seeds,
+    ret,
+    score_text,
+    sweep_score,
+    table,
+)
 
 OVER_SEEDS_HEADER = "same recipe over seeds [95% CI]"  # the header of over_seeds' cells
 #: the README's strip of GIFs: (experiment, model), shown when its GIF exists
