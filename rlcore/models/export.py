@@ -90,26 +90,8 @@ def export_model(model_dir: str | os.PathLike, fmt: str, out_dir: str | os.PathL
         if as_trained is not None:  # a bfloat16 model is exported in float32: how far that moved it
             parity["vs_as_trained_" + as_trained] = compare(acts.discrete, _outputs(acts.acting_network(policy.model), obs),
                                                             exported, figures_only=True)
-        record = {
-            "format": fmt, "file": FILES[fmt], "source_model": source or str(model_dir),
-            "experiment": exp.name, "algo": meta["algo"], "kind": kind,
-            "network": {"input": {"name": acting.inputs[0].name, "shape": [None, *obs.shape[1:]],
-                                  "dtype": str(obs.dtype)},
-                        "output": {"shape": [None, reference.shape[1]], "meaning": acts.export_output},
-                        "precision": "float32" + (f" (trained in {as_trained})" if as_trained else "")},
-            "runtime": {"name": runtime.name, "version": runtime.version},
-            "converter": converter,
-            "parity": {**parity, "observations": int(len(obs)),
-                       "seeds": seeds or "given by the caller",
-                       "policy": "sampled from pi as evaluated" if exp.goal else "greedy",
-                       "thresholds": {"max_abs_diff": f"<= {ABS_TOLERANCE:g} + {REL_TOLERANCE:g} x max |Keras output|",
-                                      **({} if not acts.discrete else
-                                         {"greedy_action_agreement": f">= {GREEDY_AGREEMENT:g}, a different "
-                                          "action counts only where the Keras scores of the two are "
-                                          "within the tolerance (a tie)"})}},
-            "versions": versions(fmt),
-            "created": datetime.now(timezone.utc).isoformat(timespec="seconds"),
-        }
+        record = _record(fmt, source or str(model_dir), exp, meta["algo"], acts, acting, obs, reference,
+                         as_trained, runtime, converter, parity, seeds)
         if not parity["passed"]:
             raise ParityError(f"{fmt} export of {source or model_dir} failed its parity check: "
                               + summary(record) + f"; nothing written to {out_dir}")
@@ -120,6 +102,32 @@ def export_model(model_dir: str | os.PathLike, fmt: str, out_dir: str | os.PathL
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     return record
+
+
+def _record(fmt: str, source: str, exp, algo: str, acts, acting, obs: np.ndarray, reference: np.ndarray,
+            as_trained: str | None, runtime, converter: dict, parity: dict, seeds: str | None) -> dict:
+    """export.json: what was exported from what, the network's input and output, the runtime, and the
+    parity check's figures and rules."""
+    return {
+        "format": fmt, "file": FILES[fmt], "source_model": source,
+        "experiment": exp.name, "algo": algo, "kind": acts.kind,
+        "network": {"input": {"name": acting.inputs[0].name, "shape": [None, *obs.shape[1:]],
+                              "dtype": str(obs.dtype)},
+                    "output": {"shape": [None, reference.shape[1]], "meaning": acts.export_output},
+                    "precision": "float32" + (f" (trained in {as_trained})" if as_trained else "")},
+        "runtime": {"name": runtime.name, "version": runtime.version},
+        "converter": converter,
+        "parity": {**parity, "observations": int(len(obs)),
+                   "seeds": seeds or "given by the caller",
+                   "policy": "sampled from pi as evaluated" if exp.goal else "greedy",
+                   "thresholds": {"max_abs_diff": f"<= {ABS_TOLERANCE:g} + {REL_TOLERANCE:g} x max |Keras output|",
+                                  **({} if not acts.discrete else
+                                     {"greedy_action_agreement": f">= {GREEDY_AGREEMENT:g}, a different "
+                                      "action counts only where the Keras scores of the two are "
+                                      "within the tolerance (a tie)"})}},
+        "versions": versions(fmt),
+        "created": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+    }
 
 
 def summary(record: dict) -> str:

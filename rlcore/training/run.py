@@ -43,33 +43,8 @@ def build_spec(experiment: str, algo: str, *, preset: str | None = None, seed: i
     overrides = dict(overrides or {})
     extra = {} if command is None else {"command": command}
     if resume:
-        spec = RunSpec(exp, algo, preset or "", None, seed, wandb_mode or "auto", Path(run_dir), True,
-                       progress=progress, final_eval_episodes=final_eval_episodes, **extra)
-        state = check_resumable(spec)
-        if wandb_mode is None:
-            spec.wandb_mode = str(state.get("wandb_mode") or "auto")
-        if final_eval_episodes is None and state.get("final_eval_episodes") is not None:
-            spec.final_eval_episodes = int(state["final_eval_episodes"])
-        config_class = type(exp.preset(algo, None))
-        # the checkpoint's own hyperparameters; budgets, rates and coefficients may be given again,
-        # what defines the env or the networks may not
-        recorded = from_dict(config_class, state["config"])
-        overrides = as_recorded(recorded, overrides)
-        check_same_run(recorded, overrides, exp.env_fields, run_dir)
-        spec.config = apply_overrides(recorded, overrides)
-        check_no_inert(spec.config, overrides)
-        before, after = to_dict(recorded), to_dict(spec.config)
-        spec.changes = {name: [before[name], after[name]] for name in overrides if before[name] != after[name]}
-        if preset is not None and preset != state["preset"]:
-            raise UserError(f"{setting('preset', preset)} cannot change on a resume: the run in {run_dir} was started "
-                            f"from the {state['preset']} preset")
-        if seed is not None and seed != state["seed"]:
-            raise UserError(f"{setting('seed', seed)} cannot change on a resume: the run in {run_dir} has seed "
-                            f"{state['seed']}")
-        spec.preset, spec.seed = state["preset"], state["seed"]
-        if not nothing_to_train_ok:
-            refuse_nothing_to_train(spec, state)
-        return spec
+        return _resumed_spec(exp, algo, preset, seed, overrides, Path(run_dir), wandb_mode, progress,
+                             final_eval_episodes, nothing_to_train_ok, extra)
     config = apply_overrides(exp.preset(algo, preset), overrides)
     check_no_inert(config, overrides)
     if getattr(config, "init_from", ""):  # PPO: a wrong folder is one line before any env process starts
@@ -79,6 +54,41 @@ def build_spec(experiment: str, algo: str, *, preset: str | None = None, seed: i
     seed = 0 if seed is None else seed
     return RunSpec(exp, algo, preset or exp.algo(algo).default_preset, config, seed, wandb_mode or "auto",
                    Path(run_dir), progress=progress, final_eval_episodes=final_eval_episodes, **extra)
+
+
+def _resumed_spec(exp, algo: str, preset: str | None, seed: int | None, overrides: dict, run_dir: Path,
+                  wandb_mode: str | None, progress: bool, final_eval_episodes: int | None,
+                  nothing_to_train_ok: bool, extra: dict) -> RunSpec:
+    """The spec of the run in ``run_dir``, resumed: its checkpoint's hyperparameters with the changes a
+    resume may make (budgets, rates, coefficients); its seed, preset and what defines the env or the
+    networks as they were."""
+    spec = RunSpec(exp, algo, preset or "", None, seed, wandb_mode or "auto", Path(run_dir), True,
+                   progress=progress, final_eval_episodes=final_eval_episodes, **extra)
+    state = check_resumable(spec)
+    if wandb_mode is None:
+        spec.wandb_mode = str(state.get("wandb_mode") or "auto")
+    if final_eval_episodes is None and state.get("final_eval_episodes") is not None:
+        spec.final_eval_episodes = int(state["final_eval_episodes"])
+    config_class = type(exp.preset(algo, None))
+    # the checkpoint's own hyperparameters; budgets, rates and coefficients may be given again,
+    # what defines the env or the networks may not
+    recorded = from_dict(config_class, state["config"])
+    overrides = as_recorded(recorded, overrides)
+    check_same_run(recorded, overrides, exp.env_fields, run_dir)
+    spec.config = apply_overrides(recorded, overrides)
+    check_no_inert(spec.config, overrides)
+    before, after = to_dict(recorded), to_dict(spec.config)
+    spec.changes = {name: [before[name], after[name]] for name in overrides if before[name] != after[name]}
+    if preset is not None and preset != state["preset"]:
+        raise UserError(f"{setting('preset', preset)} cannot change on a resume: the run in {run_dir} was started "
+                        f"from the {state['preset']} preset")
+    if seed is not None and seed != state["seed"]:
+        raise UserError(f"{setting('seed', seed)} cannot change on a resume: the run in {run_dir} has seed "
+                        f"{state['seed']}")
+    spec.preset, spec.seed = state["preset"], state["seed"]
+    if not nothing_to_train_ok:
+        refuse_nothing_to_train(spec, state)
+    return spec
 
 
 def _experiment_of(experiment: str, run_dir: Path, resume: bool, env_kwargs: dict | None):

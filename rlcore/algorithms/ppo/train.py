@@ -57,91 +57,112 @@ class Rollout:
 
 
 def train(spec: RunSpec) -> Path:
-    cfg, exp = spec.config, spec.experiment
+    """Rollouts and updates until the session says stop; the model folder at the end."""
     keras.utils.set_random_seed(spec.seed)
-    make_env = exp.training_env_factory(cfg)
-    envs = EnvPool([make_env] * cfg.num_envs, mode=cfg.vec)
+    envs = EnvPool([spec.experiment.training_env_factory(spec.config)] * spec.config.num_envs, mode=spec.config.vec)
     with envs.closed_on_error():  # a start that fails (a wrong --init-from model, say) ends them quietly
+        run = RolloutLoop(spec, envs)
+    with envs, run.session.interruptible():
+        while not run.session.should_stop():
+            log, seconds = run.collect()
+            losses = run.learn()
+            run.report(log, losses, {**seconds, "update_seconds": round(time.perf_counter() - run.learn_started, 3)})
+        run.keep_env_memory()  # the last checkpoint is written after the pool closes (session.conclude),
+        # so its reading is taken here, while the pool still answers
+    # the model's story starts with the run whose weights it started from
+    return run.session.conclude(run.checkpoint, run.agent.save, **({"init_from": run.parent} if run.parent else {}))
+
+
+class RolloutLoop:
+    """One PPO run's parts: the agent, its session and RNG, the rollout buffers, the halvings by rule, and
+    what the envs build up (Mario: the restart routes, kept by checkpoints and lent between envs)."""
+
+    def __init__(self, spec: RunSpec, envs: EnvPool):
+        cfg, exp = spec.config, spec.experiment
+        self.cfg, self.exp, self.envs = cfg, exp, envs
         obs_shape, n_actions = envs.single_observation_space.shape, int(envs.single_action_space.n)
-        agent = PPOAgent(obs_shape, n_actions, cfg)
+        self.agent = PPOAgent(obs_shape, n_actions, cfg)
         if note := bfloat16_note(cfg.precision, cpu_flags()):
             tqdm.write(note)
-        rng = np.random.default_rng(spec.seed)
-
+        self.rng = np.random.default_rng(spec.seed)
         curriculum = exp.curriculum
-        memory = curriculum.memory if curriculum else None  # what the envs build up (Mario: restart routes)
-        state, arrays = checkpoints.restore(spec, agent, rng)
+        self.memory = curriculum.memory if curriculum else None
+        state, arrays = checkpoints.restore(spec, self.agent, self.rng)
         if state is not None:
-            parent = state.get("init_from")
-            checkpoints.give_env_memory(envs, memory, arrays, curriculum.share_memory if curriculum else None, cfg)
+            self.parent = state.get("init_from")
+            checkpoints.give_env_memory(envs, self.memory, arrays, curriculum.share_memory if curriculum else None, cfg)
         else:
-            parent = init_weights(agent, cfg.init_from, exp.name, spec.algo) if cfg.init_from else None
-        session = TrainingSession(spec, state, progress_unit="step")
-        book = session.book
-        rollouts = int(state.get("rollouts", 0)) if state else 0
-        lr = LearningRateHalving(cfg.lr, cfg.lr_halve_at, state)
-        entropy = HalvingAtShares("entropy weight", cfg.entropy_coef, cfg.entropy_halve_at, state)
-        agent.set_learning_rate(lr.rate())  # a resume comes back at the values its halvings left
-        agent.set_entropy_coef(entropy.rate())
-
-        env_kept = {}  # what the envs built up (Mario: the restart routes), read while the pool is open
-
-        def checkpoint():
-            checkpoints.save(session, agent, rng, env_arrays=env_kept, rollouts=rollouts, init_from=parent,
-                             **{**lr.state(), **entropy.state()})  # one key, the best share
-
-        t, n = cfg.n_steps, cfg.num_envs
-        buf = Rollout(t, n, obs_shape, agent.obs_dtype)
-        running = np.zeros(n)
-        losses = {name: float("nan") for name in UPDATE_NAMES}  # CSV columns exist from the first row
+            self.parent = init_weights(self.agent, cfg.init_from, exp.name, spec.algo) if cfg.init_from else None
+        self.session = TrainingSession(spec, state, progress_unit="step")
+        self.rollouts = int(state.get("rollouts", 0)) if state else 0
+        self.lr = LearningRateHalving(cfg.lr, cfg.lr_halve_at, state)
+        self.entropy = HalvingAtShares("entropy weight", cfg.entropy_coef, cfg.entropy_halve_at, state)
+        self.agent.set_learning_rate(self.lr.rate())  # a resume comes back at the values its halvings left
+        self.agent.set_entropy_coef(self.entropy.rate())
+        self.env_kept: dict = {}  # what the envs built up, read while the pool is open
+        self.buf = Rollout(cfg.n_steps, cfg.num_envs, obs_shape, self.agent.obs_dtype)
+        self.running = np.zeros(cfg.num_envs)
+        self.losses = {name: float("nan") for name in UPDATE_NAMES}  # CSV columns exist from the first row
         # a resumed run starts fresh episodes, reseeded from its episode count
-        obs, _ = envs.reset(seed=session.fresh_env_seeds(n))
-    with envs, session.interruptible():
-        while not session.should_stop():
-            log = RolloutLog(exp)
-            truncated_values = {}
-            started = time.perf_counter()
-            for step in range(t):
-                actions, logp, values = agent.act(obs, rng)
-                next_obs, rewards, terminated, truncated, infos = envs.step(actions)
-                done = terminated | truncated
-                buf.obs[step], buf.actions[step], buf.logp[step], buf.values[step] = obs, actions, logp, values
-                buf.rewards[step], buf.terminated[step], buf.dones[step] = rewards, terminated, done
-                session.env_steps += n
-                running += rewards
-                log.step(infos)
-                cut = np.flatnonzero(truncated & ~terminated)
-                if len(cut):  # one batched call for every env cut by a time limit this step
-                    finals = agent.values(np.stack([infos["final_obs"][i] for i in cut]))
-                    truncated_values.update({(step, i): float(v) for i, v in zip(cut, finals)})
-                for i in np.flatnonzero(done):
-                    row, won, counted = log.episode(infos, i, losses)
-                    session.end_episode(running[i], row, success=won, counted=counted)
-                    running[i] = 0.0
-                obs = next_obs
-                session.advance(n)
-            buf.close(agent.values(obs), truncated_values)
-            collected = time.perf_counter()
-            with reported_divergence(session, "PPO", "lower the learning rate"):
-                losses = agent.update(*buf.arrays(), rng)
-            rollouts += 1
-            seconds = {"collect_seconds": round(collected - started, 3),  # where a rollout's time goes
-                       "update_seconds": round(time.perf_counter() - collected, 3)}
-            session.log_rollout(rollouts, {**log.row(), **losses, "lr": lr.rate(),
-                                           "entropy_coef": entropy.rate(), **seconds})
-            line = log.line(rollouts, session.env_steps, book, cfg.window)
-            tqdm.write(line + f" | loss {losses['loss']:.3f} entropy {losses['entropy']:.2f}")
-            for halving, apply in ((lr, agent.set_learning_rate), (entropy, agent.set_entropy_coef)):
-                if halved := halving.observe(book.settled_success_share):
-                    apply(halving.rate())
-                    tqdm.write(halved)
-            if rollouts % cfg.checkpoint_rollouts == 0:
-                env_kept = checkpoints.env_memory(envs, memory)
-                checkpoint()
-        env_kept = checkpoints.env_memory(envs, memory)  # the last checkpoint is written after the pool
-        # closes (session.conclude), so its reading is taken here, while the pool still answers
-    # the model's story starts with the run whose weights it started from
-    return session.conclude(checkpoint, agent.save, **({"init_from": parent} if parent else {}))
+        self.obs, _ = envs.reset(seed=self.session.fresh_env_seeds(cfg.num_envs))
+        self.learn_started = 0.0
+
+    def checkpoint(self) -> None:
+        checkpoints.save(self.session, self.agent, self.rng, env_arrays=self.env_kept, rollouts=self.rollouts,
+                         init_from=self.parent, **{**self.lr.state(), **self.entropy.state()})  # one key, the best share
+
+    def collect(self) -> tuple[RolloutLog, dict]:
+        """``n_steps`` steps of every env into the buffers; a truncated episode's final observation valued
+        in one batched call per step; each ended episode's row to the session."""
+        log, truncated_values, started = RolloutLog(self.exp), {}, time.perf_counter()
+        buf, session, n = self.buf, self.session, self.cfg.num_envs
+        for step in range(self.cfg.n_steps):
+            actions, logp, values = self.agent.act(self.obs, self.rng)
+            next_obs, rewards, terminated, truncated, infos = self.envs.step(actions)
+            done = terminated | truncated
+            buf.obs[step], buf.actions[step], buf.logp[step], buf.values[step] = self.obs, actions, logp, values
+            buf.rewards[step], buf.terminated[step], buf.dones[step] = rewards, terminated, done
+            session.env_steps += n
+            self.running += rewards
+            log.step(infos)
+            cut = np.flatnonzero(truncated & ~terminated)
+            if len(cut):  # one batched call for every env cut by a time limit this step
+                finals = self.agent.values(np.stack([infos["final_obs"][i] for i in cut]))
+                truncated_values.update({(step, i): float(v) for i, v in zip(cut, finals)})
+            for i in np.flatnonzero(done):
+                row, won, counted = log.episode(infos, i, self.losses)
+                session.end_episode(self.running[i], row, success=won, counted=counted)
+                self.running[i] = 0.0
+            self.obs = next_obs
+            session.advance(n)
+        buf.close(self.agent.values(self.obs), truncated_values)
+        return log, {"collect_seconds": round(time.perf_counter() - started, 3)}  # where a rollout's time goes
+
+    def learn(self) -> dict:
+        """One PPO update on the rollout; a NaN loss ends the run with one line."""
+        self.learn_started = time.perf_counter()
+        with reported_divergence(self.session, "PPO", "lower the learning rate"):
+            self.losses = self.agent.update(*self.buf.arrays(), self.rng)
+        self.rollouts += 1
+        return self.losses
+
+    def report(self, log: RolloutLog, losses: dict, seconds: dict) -> None:
+        """The rollout's row and console line, the halvings the share has earned, a checkpoint when due."""
+        session, book = self.session, self.session.book
+        session.log_rollout(self.rollouts, {**log.row(), **losses, "lr": self.lr.rate(),
+                                            "entropy_coef": self.entropy.rate(), **seconds})
+        line = log.line(self.rollouts, session.env_steps, book, self.cfg.window)
+        tqdm.write(line + f" | loss {losses['loss']:.3f} entropy {losses['entropy']:.2f}")
+        for halving, apply in ((self.lr, self.agent.set_learning_rate), (self.entropy, self.agent.set_entropy_coef)):
+            if halved := halving.observe(book.settled_success_share):
+                apply(halving.rate())
+                tqdm.write(halved)
+        if self.rollouts % self.cfg.checkpoint_rollouts == 0:
+            self.keep_env_memory()
+            self.checkpoint()
+
+    def keep_env_memory(self) -> None:
+        self.env_kept = checkpoints.env_memory(self.envs, self.memory)
 
 
 def init_weights(agent: PPOAgent, folder: str, experiment: str, algo: str) -> dict:
