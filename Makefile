@@ -85,18 +85,13 @@ docs-check: $(ALL)
 	$(PY) -m tools.docgen --check
 	$(VENV)/bin/mkdocs build --strict --quiet --site-dir build/site-check
 
-# The README's and the model cards' GIFs, from the shipped models, each on a stated evaluation seed
-# (the first, 1000000, unless said). Mario plays as it is evaluated (actions sampled from pi, the
-# episode's RNG seeded with its seed) on a seed where its recorded evaluation reached the flag:
-# 1-1 on 1000000, 1-4 on 1000001 (it fell short on 1000000). `render` prints whether it did again.
-GIF_DIR := docs/assets/gifs
+# The README's and the model cards' GIFs, one per shipped model, each on a stated evaluation seed: the first
+# of its recorded evaluation, or for Mario the first on which that evaluation reached the flag, played as it
+# is evaluated (tools/gifs.py; `render` prints whether it reached it again). `python -m tools.gifs --missing`
+# makes only the cards' missing ones.
 .PHONY: gifs
 gifs: $(ALL)
-	$(PY) main.py render mario_ppo ppo --world 1 --stage 1 --seed 1000000 --out $(GIF_DIR)/mario_ppo_1-1.gif
-	$(PY) main.py render mario_ppo ppo --world 1 --stage 4 --seed 1000001 --out $(GIF_DIR)/mario_ppo_1-4.gif
-	$(PY) main.py render lunar_lander dqn --seed 1000000 --out $(GIF_DIR)/lunar_lander_dqn.gif
-	$(PY) main.py render minitaur sac --seed 1000000 --episodes 1 --out $(GIF_DIR)/minitaur_sac.gif
-	$(PY) main.py render cartpole a2c --seed 1000000 --out $(GIF_DIR)/cartpole_a2c.gif
+	$(PY) -m tools.gifs
 
 # Commit the checkpoints and CSV tables of the runs under long_runs/ (before every stop of a session).
 save-long-runs:
