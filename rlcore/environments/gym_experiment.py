@@ -31,6 +31,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from rlcore.algorithms.registry import FAMILIES, family
+from rlcore.environments.env_kwargs import check_env_kwargs
 from rlcore.environments.experiment import AlgoSpec, Experiment
 from rlcore.errors import UserError
 
@@ -198,8 +199,6 @@ _BUILT: dict[tuple[str, str, tuple[str, ...]], Experiment] = {}
 def _build(name: str, env_kwargs: dict) -> Experiment:
     spec = gym_spec(name)
     if env_kwargs:
-        from rlcore.environments.env_kwargs import check_env_kwargs
-
         check_env_kwargs(spec.id, env_kwargs)
     try:
         env = make_gym_env(name=name, env_kwargs=env_kwargs)
