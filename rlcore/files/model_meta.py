@@ -1,4 +1,5 @@
-"""A model folder's ``meta.json`` read back, every way it can be wrong named in one line."""
+"""The JSON records a run keeps (a model folder's ``meta.json``, ``sweep.json``) read back, every way one can
+be wrong (missing, a folder, binary, cut short, not a record) named in one line."""
 from __future__ import annotations
 
 import json
@@ -18,7 +19,22 @@ def read_meta(model_dir: str | Path) -> dict:
     if not meta_path.is_file():
         raise UserError(f"{model_dir} has no meta.json: not a model folder of this package (a run's model/ "
                         "folder, or a shipped one under saved_networks/)")
+    return read_json(meta_path, "put back a good copy of the model folder (or train it again)")
+
+
+def read_json(path: Path, fix: str) -> dict:
+    """The JSON object in ``path``; a :class:`UserError` naming the file, what is wrong and ``fix``."""
+    path = Path(path)
     try:
-        return json.loads(meta_path.read_text())
+        data = json.loads(path.read_bytes().decode("utf-8"))
+    except IsADirectoryError:
+        raise UserError(f"{path} is a folder where a JSON record should be; {fix}") from None
+    except FileNotFoundError:
+        raise UserError(f"{path} is missing; {fix}") from None
+    except UnicodeDecodeError:
+        raise UserError(f"{path} is damaged (not text: binary bytes); {fix}") from None
     except json.JSONDecodeError as exc:
-        raise UserError(f"{meta_path} is damaged ({exc.msg} at line {exc.lineno})")
+        raise UserError(f"{path} is damaged ({exc.msg} at line {exc.lineno}); {fix}") from None
+    if not isinstance(data, dict):
+        raise UserError(f"{path} is damaged (it holds no JSON object); {fix}")
+    return data

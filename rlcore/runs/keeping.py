@@ -8,6 +8,7 @@ import json
 import shutil
 from pathlib import Path
 
+from rlcore.files.model_meta import read_json
 from rlcore.errors import UserError
 from rlcore.runs.report import load_runs
 from rlcore.runs.commands import command_starts
@@ -89,7 +90,7 @@ def keep_runs(run_dirs: list[Path], dest: Path) -> Path:
     from rlcore.hyperparams.flags import to_dict
 
     run_dirs, dest = [Path(d) for d in run_dirs], Path(dest)
-    metas = [json.loads((d / "model" / "meta.json").read_text()) for d in run_dirs]
+    metas = [read_json(d / "model" / "meta.json", "keep only finished runs") for d in run_dirs]
     first = metas[0]
     for d, meta in zip(run_dirs, metas):
         check_one_recipe_throughout(d, meta)

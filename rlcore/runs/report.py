@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from rlcore.files.model_meta import read_json
 from rlcore.runs.bootstrap import AGGREGATES, aggregates, probability_of_improvement, stratified_bootstrap_ci
 from rlcore.errors import UserError
 from rlcore.runs.eval_history import stability_summary, story, story_text
@@ -27,7 +28,7 @@ def load_runs(sweep_dir: Path) -> list[dict]:
         raise UserError(f"no sweep folder {sweep_dir}")
     rows, unevaluated = [], []
     for meta_path in sorted(sweep_dir.glob("*/model/meta.json")):
-        meta = json.loads(meta_path.read_text())
+        meta = read_json(meta_path, "move that run's folder aside or train it again")
         ev = meta.get("evaluation") or {}
         score = ev.get("success_share", ev.get("mean"))
         if score is None:

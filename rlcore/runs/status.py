@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from rlcore.files.model_meta import read_json
 from rlcore.training.evaluation import count_causes
 from rlcore.runs.plotting import full_episodes, read_table
 from rlcore.runs.pace import pace_text
@@ -115,8 +116,8 @@ def run_record(run_dir: str | Path) -> dict | None:
     from rlcore.training.spec import CHECKPOINT_FILE
 
     run_dir = Path(run_dir)
-    meta = next((json.loads(path.read_text()) for path in (run_dir / "model" / "meta.json", run_dir / "meta.json")
-                 if path.is_file()), None)
+    meta = next((read_json(path, "put back a good copy") for path in (run_dir / "model" / "meta.json",
+                                                                      run_dir / "meta.json") if path.is_file()), None)
     if (run_dir / CHECKPOINT_FILE).is_file():
         state = read_checkpoint_state(run_dir / CHECKPOINT_FILE)
         if meta is None or state.get("env_steps", 0) > meta.get("env_steps", 0):

@@ -14,12 +14,12 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import itertools
-import json
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 from rlcore.errors import UserError
 from rlcore.files.atomic import write_json
+from rlcore.files.model_meta import read_json
 
 SWEEP_FILE = "sweep.json"
 STOP_FILE = "STOP"
@@ -57,7 +57,7 @@ class Sweep:
         path = Path(folder) / SWEEP_FILE
         if not path.is_file():
             raise UserError(f"no sweep to resume in {folder} (no {SWEEP_FILE}); start it without --resume")
-        data = json.loads(path.read_text())
+        data = read_json(path, "put back a good copy of the sweep's folder")
         data["folder"] = str(Path(folder).resolve())  # where it is now (a clone elsewhere), not where it began
         return cls(**data)
 

@@ -19,6 +19,7 @@ import time
 from pathlib import Path
 
 from rlcore.errors import UserError
+from rlcore.files.model_meta import read_json
 from rlcore.sweeps.sweep import STOP_FILE, TRIALS_LOG, Sweep, trial_name
 
 
@@ -33,7 +34,7 @@ def run_trial(trial: dict, sweep: dict, modules: dict, report) -> dict:
     sweep = Sweep(**sweep)
     run_dir = Path(sweep.folder) / trial_name(trial)
     meta_path = run_dir / "model" / "meta.json"
-    meta = json.loads(meta_path.read_text()) if meta_path.is_file() else None
+    meta = read_json(meta_path, "move the trial's folder aside to train it again") if meta_path.is_file() else None
     if meta is not None and not _wants_evaluation(sweep, meta):  # finished before: not run again
         return final_metrics(meta, skipped=True)
     if (Path(sweep.folder) / STOP_FILE).exists():  # the sweep is stopping: a trial not begun stays so
