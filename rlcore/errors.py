@@ -19,7 +19,8 @@ class WriteFailed(UserError):
                 errno.EDQUOT: f"the disk quota is used up: free some space, then {then}",
                 errno.EROFS: "the file system is read-only: write elsewhere",
                 errno.EACCES: "no permission to write there: write elsewhere"}.get(exc.errno, f"check the disk and the folder, then {then}")
-        super().__init__(f"cannot write {path}: {exc.strerror or exc}; {what}")
+        reason = exc.strerror or (str(exc).strip().splitlines() or [type(exc).__name__])[0]  # a writer's log: its first line
+        super().__init__(f"cannot write {path}: {reason}; {what}")
         self.errno = exc.errno
 
 

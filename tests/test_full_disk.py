@@ -105,3 +105,20 @@ def test_an_export_onto_a_full_disk_is_one_line_and_an_earlier_export_stays_whol
         assert {p.relative_to(earlier): p.read_bytes() for p in earlier.rglob("*") if p.is_file()} == before
         assert not [p for p in small_disk.iterdir() if p.name.startswith(".")], "a temporary folder was left"
     filler.unlink()
+
+
+@pytest.mark.parametrize("suffix", ["gif", "mp4"])
+def test_a_video_onto_a_full_disk_is_one_line_and_an_earlier_one_stays_whole(small_disk, capfd, suffix):
+    """Pillow failed again in imageio's __del__ (a traceback after our line), and ffmpeg printed its log and
+    a broken pipe: each is now the one line naming the video, with no temporary file left."""
+    video = small_disk / f"lander.{suffix}"
+    assert run(capfd, "render", "lunar_lander", "dqn", "--out", str(video))[0] == 0
+    before = video.read_bytes()
+    filler = fill(small_disk, 0)
+    code, _, err = run(capfd, "render", "lunar_lander", "dqn", "--out", str(video))
+    lines = err.strip().splitlines()
+    assert code == 2 and len(lines) == 1 and lines[0].startswith(f"error: cannot write {video}: No space left"), lines
+    assert lines[0].endswith("then render again")
+    assert video.read_bytes() == before
+    assert not [p for p in small_disk.iterdir() if p.name.startswith(".")], "a temporary file was left"
+    filler.unlink()

@@ -34,14 +34,14 @@ def writable_folder(folder: str | os.PathLike, what: str) -> Path:
 
 
 @contextlib.contextmanager
-def atomic_path(target: str | os.PathLike) -> Iterator[Path]:
+def atomic_path(target: str | os.PathLike, then: str = "resume the run") -> Iterator[Path]:
     """Yield a temporary path in the target's folder; on success move it onto ``target``.
 
     The temporary name keeps the target's suffix, so writers that pick a format from the
     extension (Keras ``.h5``, imageio ``.mp4``, numpy ``.npz``) still work.
 
     A full disk or an unwritable folder is a :class:`WriteFailed` naming ``target``: the previous
-    file stays as it was and the temporary one is removed.
+    file stays as it was and the temporary one is removed; ``then`` says what to do once there is room.
     """
     target = Path(target)
     try:
@@ -49,7 +49,7 @@ def atomic_path(target: str | os.PathLike) -> Iterator[Path]:
         fd, tmp = tempfile.mkstemp(prefix=f".{target.stem}.", suffix=".tmp" + target.suffix,
                                    dir=target.parent)
     except OSError as exc:
-        raise WriteFailed(target, exc) from None
+        raise WriteFailed(target, exc, then) from None
     os.close(fd)
     tmp = Path(tmp)
     try:
@@ -57,7 +57,7 @@ def atomic_path(target: str | os.PathLike) -> Iterator[Path]:
         os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the file normal permissions
         os.replace(tmp, target)
     except OSError as exc:
-        raise WriteFailed(target, exc) from None
+        raise WriteFailed(target, exc, then) from None
     finally:
         if tmp.exists():
             tmp.unlink()
@@ -104,7 +104,7 @@ def replace_folder(target: str | os.PathLike, fill: Callable[[Path], None]) -> P
         else:
             os.replace(fresh, target)
     except OSError as exc:
-        raise WriteFailed(target, exc) from None
+        raise WriteFailed(target, exc, then) from None
     finally:
         if fresh is not None and fresh.exists():
             shutil.rmtree(fresh, ignore_errors=True)

@@ -2,7 +2,10 @@
 to a small looping GIF (imageio's Pillow plugin), chosen by the file's suffix."""
 from __future__ import annotations
 
+import contextlib
+import errno
 import os
+import shutil
 from functools import partial
 from pathlib import Path
 
@@ -37,15 +40,33 @@ def gif_every(fps: int) -> int:
 class _Mp4:
     def __init__(self, path: Path, fps: int):
         # macro_block_size=1 keeps odd frame sizes (LunarLander is 600x400: fine either way)
-        self.writer = imageio.get_writer(path, fps=fps, codec="libx264", macro_block_size=1)
+        # ffmpeg says nothing on the console: a failed write is our one line (written_by_ffmpeg)
+        self.path = path
+        self.writer = imageio.get_writer(path, fps=fps, codec="libx264", macro_block_size=1, ffmpeg_log_level="quiet")
         self.frames = 0
 
     def add(self, frame: np.ndarray) -> None:
-        self.writer.append_data(frame)
+        with written_by_ffmpeg(self.path):
+            self.writer.append_data(frame)
         self.frames += 1
 
     def close(self) -> None:
-        self.writer.close()
+        with written_by_ffmpeg(self.path):
+            self.writer.close()
+
+
+@contextlib.contextmanager
+def written_by_ffmpeg(path: Path):
+    """ffmpeg's failures (a broken pipe, its log) as the OS error behind them: a full disk where the
+    folder has no room left, else the message's first line."""
+    try:
+        yield
+    except (OSError, RuntimeError, ValueError) as exc:
+        if isinstance(exc, OSError) and exc.errno not in (errno.EPIPE, None):
+            raise
+        if shutil.disk_usage(path.parent).free < 1 << 20:
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC)) from None
+        raise OSError(errno.EIO, (str(exc).strip().splitlines() or ["ffmpeg failed"])[0]) from None
 
 
 class _Gif:
@@ -81,8 +102,11 @@ class _Gif:
         ends = np.cumsum(self.shown_for) * slot
         clock = np.round(np.concatenate([[0.0], ends]), -1)
         durations = [max(20, int(d)) for d in np.diff(clock)]
-        iio.imwrite(self.path, np.stack(self.kept), extension=".gif", loop=0,
-                    duration=durations if len(durations) > 1 else durations[0])
+        # encoded in memory, then written in one call: a full disk is one OSError, not Pillow's flush
+        # failing again in the plugin's __del__
+        data = iio.imwrite("<bytes>", np.stack(self.kept), extension=".gif", loop=0,
+                           duration=durations if len(durations) > 1 else durations[0])
+        self.path.write_bytes(data)
 
 
 def _shrink(frame: np.ndarray) -> np.ndarray:
@@ -133,7 +157,7 @@ def record_video(experiment, policy, path: str | Path, fps: int = 30, episodes: 
     returns, lengths, successes = [], [], []
     goal = getattr(experiment, "goal", None)
     success_key = goal.success_key if goal else None
-    with atomic_path(path) as tmp:
+    with atomic_path(path, then="render again") as tmp:
         writer = _Gif(tmp, fps, gif_every(fps)) if gif else _Mp4(tmp, fps)
         try:
             for episode in range(episodes):
