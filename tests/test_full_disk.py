@@ -122,3 +122,20 @@ def test_a_video_onto_a_full_disk_is_one_line_and_an_earlier_one_stays_whole(sma
     assert video.read_bytes() == before
     assert not [p for p in small_disk.iterdir() if p.name.startswith(".")], "a temporary file was left"
     filler.unlink()
+
+
+def test_a_report_and_a_keep_onto_a_full_disk_are_one_line(small_disk, capfd):
+    """report.md, its PNGs and a kept folder: one line each naming the file, what to do next in the
+    command's own words; --keep leaves no half-made folder."""
+    sweep = small_disk / "sweep"
+    shutil.copytree(Path(__file__).resolve().parents[1] / "results" / "sweeps" / "cartpole__a2c", sweep)
+    filler = fill(small_disk, 0)
+    code, _, err = run(capfd, "report", str(sweep), "--out", str(small_disk / "report"))
+    lines = err.strip().splitlines()
+    assert code == 2 and len(lines) == 1 and "No space left" in lines[0] and lines[0].endswith("then report again"), lines
+    code, _, err = run(capfd, "report", str(sweep / "seed=0"), str(sweep / "seed=1"), "--keep", str(small_disk / "kept"))
+    lines = err.strip().splitlines()
+    assert code == 2 and len(lines) == 1 and "No space left" in lines[0] and "Traceback" not in err, lines
+    assert not (small_disk / "kept").exists()
+    assert not [p for p in small_disk.iterdir() if p.name.startswith(".")], "a temporary folder was left"
+    filler.unlink()

@@ -126,7 +126,7 @@ def cmd_report(args) -> int:
         return 0
     from rlcore.files.atomic import write_atomic
     out.mkdir(parents=True, exist_ok=True)  # after the summary: a sweep that cannot be read leaves no folder
-    write_atomic(out / "report.md", lambda p: p.write_text(text + "\n"))
+    write_atomic(out / "report.md", lambda p: p.write_text(text + "\n"), then="report again")
     figures = {"report_curves.png": lambda path: plot_curves(result, path),
                "report_success.png": lambda path: plot_curves(result, path, column=SUCCESS_SHARE),
                "report_evals.png": lambda path: plot_evals(result, path),

@@ -69,9 +69,9 @@ def _umask() -> int:
     return mask
 
 
-def write_atomic(target: str | os.PathLike, writer: Callable[[Path], None]) -> None:
+def write_atomic(target: str | os.PathLike, writer: Callable[[Path], None], then: str = "resume the run") -> None:
     """Call ``writer(tmp_path)`` and move the result onto ``target``."""
-    with atomic_path(target) as tmp:
+    with atomic_path(target, then) as tmp:
         writer(tmp)
 
 
@@ -104,7 +104,7 @@ def replace_folder(target: str | os.PathLike, fill: Callable[[Path], None]) -> P
         else:
             os.replace(fresh, target)
     except OSError as exc:
-        raise WriteFailed(target, exc, then) from None
+        raise WriteFailed(target, exc, "keep them again") from None
     finally:
         if fresh is not None and fresh.exists():
             shutil.rmtree(fresh, ignore_errors=True)

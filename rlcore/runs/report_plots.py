@@ -72,7 +72,7 @@ def _save_figure(fig, ax, ylabel: str, out: Path) -> Path:
     ax.grid(alpha=0.3)
     fig.tight_layout()
     out = Path(out)
-    with atomic_path(out) as tmp:
+    with atomic_path(out, then="report again") as tmp:
         fig.savefig(tmp, dpi=110)
     plt.close(fig)
     return out
