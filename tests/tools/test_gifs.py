@@ -19,3 +19,4 @@ def test_every_shipped_model_has_a_render_command_of_its_own_folder():
     for slug, command in commands.items():
         assert command[command.index("--model") + 1] == models[slug].folder
         assert command[-1] == f"docs/assets/gifs/{slug}.gif"
+
