@@ -187,7 +187,7 @@ def gym_experiment(name: str, env_kwargs: dict | None = None) -> Experiment:
     (which may change its spaces, so the algorithms that fit); an unknown id is a :class:`UserError`. Built
     once per process, name and arguments."""
     env_kwargs = dict(env_kwargs or {})
-    key = (name, json.dumps(env_kwargs, sort_keys=True), tuple(FAMILIES))  # a family registered since is offered too
+    key = (name, json.dumps(env_kwargs, sort_keys=True, default=repr), tuple(FAMILIES))  # a family registered since is offered too
     if key not in _BUILT:
         _BUILT[key] = _build(name, env_kwargs)
     return _BUILT[key]
