@@ -5,6 +5,7 @@ runs), plus two lever runs that measure a cheaper recipe (``--epochs 4``) on 1-1
 Each level's run is then evaluated on 30 further unseen seeds.
 
     .venv/bin/python long_runs/queue.py --dry-run     # the next command, from the folders' state
+    .venv/bin/python long_runs/queue.py --status      # where each run stands, a line each
     setsid nohup .venv/bin/python long_runs/queue.py > /tmp/queue.log 2>&1 &
 
 Each step is read from the folders when the step before it ends, so the queue can be stopped and started
@@ -73,11 +74,49 @@ def _evaluated(meta: Path) -> bool:
     return bool(json.loads(meta.read_text()).get("evaluation"))
 
 
+def run_status(name: str, folders: Path = HERE) -> str:
+    """One line: queued, at a checkpoint (env steps, episodes, the flag share of the last 100 episodes from
+    the level's start), or finished (what ended it, and the flag on unseen seeds)."""
+    run = folders / run_dir(name)
+    meta = run / "model" / "meta.json"
+    if meta.is_file():
+        record = json.loads(meta.read_text())
+        scores = [record.get("evaluation") or {}] + list(record.get("further_evaluations") or [])
+        flags = ", ".join(f"{round(e['success_share'] * e['episodes'])} of {e['episodes']}" for e in scores
+                          if "success_share" in e and "episodes" in e)
+        return (f"{name}: finished at {record.get('env_steps', 0):,} env steps ({record.get('stopped_by', '?')}); "
+                f"flag on unseen seeds: {flags or 'not evaluated yet'}")
+    if (run / "checkpoint.npz").is_file():
+        return f"{name}: in progress (a checkpoint kept); " + _progress(run / "metrics.csv")
+    return f"{name}: queued"
+
+
+def _progress(metrics: Path) -> str:
+    """Env steps and episodes so far, and the flag in the last 100 episodes from the level's start."""
+    import csv
+
+    try:
+        with open(metrics, newline="", encoding="utf-8", errors="replace") as f:
+            rows = list(csv.DictReader(f))
+    except OSError:
+        return "no metrics.csv"
+    if not rows:
+        return "no episode yet"
+    counted = [r for r in rows if r.get("restarted") in (None, "", "0", "0.0")][-100:]
+    flags = sum(r.get("success") in ("1", "1.0", "True") for r in counted)
+    return (f"{int(float(rows[-1]['env_steps'])):,} env steps, {len(rows):,} episodes, "
+            f"flag in {flags} of the last {len(counted)} from the start")
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--dry-run", action="store_true", help="print the next command and exit")
+    parser.add_argument("--status", action="store_true", help="print where each run stands and exit")
     args = parser.parse_args(argv)
+    if args.status:
+        print("\n".join(run_status(name) for name, _, _ in RUNS))
+        return 0
     if args.dry_run:
         command = next_command()
         print("nothing left to run" if command is None else " ".join(["python", "main.py", *command]))

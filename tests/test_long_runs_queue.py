@@ -89,3 +89,18 @@ def test_the_readme_gives_the_queues_command():
         world, stage = level.split("-")
         given = line.replace("--world W --stage S", f"--world {world} --stage {stage}").replace("W-S", level)
         assert vars(_parses(given.split()[2:])) == vars(_parses(queue.train_command(level, level, [])))
+
+
+def test_status_says_where_each_run_stands(tmp_path):
+    lines = {name: queue.run_status(name, tmp_path) for name, _, _ in queue.RUNS}
+    assert set(lines.values()) == {f"{name}: queued" for name in lines}
+    run = tmp_path / queue.run_dir("1-1")
+    run.mkdir(parents=True)
+    (run / "checkpoint.npz").write_bytes(b"")
+    (run / "metrics.csv").write_text("episode,success,env_steps,restarted\n1,1,100,0\n2,0,200,1\n3,0,300,0\n")
+    assert queue.run_status("1-1", tmp_path) == ("1-1: in progress (a checkpoint kept); 300 env steps, 3 episodes, flag in 1 of "
+                                                 "the last 2 from the start")
+    _finish(run, env_steps=5000, stopped_by="stop_success_share 0.95",
+            evaluation={"success_share": 0.9, "episodes": 30}, further_evaluations=[{"success_share": 1.0, "episodes": 30}])
+    assert queue.run_status("1-1", tmp_path) == ("1-1: finished at 5,000 env steps (stop_success_share 0.95); flag on "
+                                                 "unseen seeds: 27 of 30, 30 of 30")
