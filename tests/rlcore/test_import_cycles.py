@@ -104,3 +104,13 @@ def test_the_check_finds_a_cycle_hidden_in_a_function(tmp_path):
     assert imported(late, {"rlcore.b", "rlcore.c"}) == {"rlcore.b"}  # the annotation-only import is no edge
     graph = {"rlcore.a": {"rlcore.b"}, "rlcore.b": {"rlcore.c"}, "rlcore.c": {"rlcore.a"}, "rlcore.d": {"rlcore.a"}}
     assert cycles(graph) == [["rlcore.a", "rlcore.b", "rlcore.c"]]
+
+
+def test_every_folder_of_code_is_a_package_the_wheel_finds():
+    """setup.cfg's `packages = find:` takes only folders with an __init__.py: one without (rlcore/runs/ was
+    ignored by a `runs/` line meant for the top-level run folders) would be left out of a wheel."""
+    from setuptools import find_packages
+
+    found = set(find_packages(str(ROOT), include=["rlcore", "rlcore.*"]))
+    folders = {".".join(p.parent.relative_to(ROOT).parts) for p in (ROOT / "rlcore").rglob("*.py")}
+    assert folders <= found, sorted(folders - found)
