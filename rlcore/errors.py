@@ -24,13 +24,15 @@ class WriteFailed(UserError):
         self.errno = exc.errno
 
 
-def disk_error(exc: BaseException) -> OSError | None:
-    """The OS error behind a library's failed write (TensorFlow's ResourceExhaustedError on a full disk,
-    a converter's message that quotes the OS), or None when ``exc`` is no disk error."""
+def disk_error(exc: BaseException, folder=None) -> OSError | None:
+    """The OS error behind a library's failed write into ``folder`` (TensorFlow's ResourceExhaustedError on a
+    full disk, a converter's message that quotes the OS, ffmpeg's broken pipe where the disk has filled), or
+    None when ``exc`` is no disk error."""
     import errno
     import os
+    import shutil
 
-    if isinstance(exc, OSError):
+    if isinstance(exc, OSError) and exc.errno not in (errno.EPIPE, None):  # ffmpeg's pipe: errno None or EPIPE
         return exc
     text = f"{type(exc).__name__}: {exc}"
     for code, words in ((errno.ENOSPC, "No space left"), (errno.EROFS, "Read-only file system"),
@@ -39,4 +41,6 @@ def disk_error(exc: BaseException) -> OSError | None:
             return OSError(code, os.strerror(code))
     if type(exc).__name__ == "ResourceExhaustedError":  # TensorFlow's writers on a full disk
         return OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
-    return None
+    if folder is not None and shutil.disk_usage(folder).free < 1 << 20:  # a writer process's pipe broke
+        return OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+    return exc if isinstance(exc, OSError) else None

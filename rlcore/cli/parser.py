@@ -381,21 +381,9 @@ def _add_hyperparameters(train: argparse.ArgumentParser, argv: list[str]) -> Non
     from rlcore.hyperparams.flags import add_arguments
 
     given = env_kwargs_value(names.env_kwargs) if names.env_kwargs else None
-    recorded = _recorded_env(names.resume)  # a resume's flags are its run's (a change is refused later)
-    experiment = get_experiment(names.experiment, recorded, env_kwargs=None if recorded else given)
+    from rlcore.training.spec import recorded_env
+
+    # a resume's flags are its run's (a change of --env-kwargs is refused later)
+    recorded = recorded_env(names.resume) if names.resume and names.resume != "latest" else {}
+    experiment = get_experiment(names.experiment, recorded or None, env_kwargs=None if recorded else given)
     add_arguments(train, experiment.preset(names.algo, names.preset))
-
-
-def _recorded_env(resume: str | None) -> dict | None:
-    """The env a resumed run records (a Gymnasium id's --env-kwargs among it), read quietly: a missing or
-    damaged checkpoint is the resume's own error to report."""
-    if not resume or resume == "latest":
-        return None
-    from pathlib import Path
-
-    from rlcore.files.checkpoint import read_checkpoint_state
-
-    try:
-        return read_checkpoint_state(Path(resume) / "checkpoint.npz").get("env") or None
-    except (UserError, OSError, ValueError):
-        return None

@@ -42,15 +42,20 @@ def _value(text: str):
         return text
 
 
-def check_env_kwargs(env_id: str, kwargs: dict) -> None:
-    """Each key a parameter the env's entry point takes (any, when it takes ``**kwargs``); one line else."""
+def env_creator(env_id: str):
+    """What the registered id's entry point names: the env class or the function that builds it."""
     import gymnasium as gym
     from gymnasium.envs.registration import load_env_creator
 
+    entry_point = gym.spec(env_id).entry_point
+    return load_env_creator(entry_point) if isinstance(entry_point, str) else entry_point
+
+
+def check_env_kwargs(env_id: str, kwargs: dict) -> None:
+    """Each key a parameter the env's entry point takes (any, when it takes ``**kwargs``); one line else."""
     if "render_mode" in kwargs:
         raise UserError("--env-kwargs: render_mode is set by the command (render, video), not given")
-    entry_point = gym.spec(env_id).entry_point
-    creator = load_env_creator(entry_point) if isinstance(entry_point, str) else entry_point
+    creator = env_creator(env_id)
     try:
         parameters = inspect.signature(creator).parameters
     except (TypeError, ValueError):  # a builtin: only trying tells

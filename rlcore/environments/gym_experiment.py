@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from rlcore.algorithms.registry import FAMILIES, family
-from rlcore.environments.env_kwargs import check_env_kwargs
+from rlcore.environments.env_kwargs import check_env_kwargs, env_creator
 from rlcore.environments.experiment import AlgoSpec, Experiment
 from rlcore.errors import UserError
 
@@ -134,12 +134,7 @@ def _make(env_id: str, render_mode: str | None, max_episode_steps: int | None, e
 def _declared_modes(env_id: str) -> list[str] | None:
     """The render modes the env's class declares (its ``metadata``), read without building it; None when
     its entry point is a function that declares nothing (then only trying tells)."""
-    import gymnasium as gym
-    from gymnasium.envs.registration import load_env_creator
-
-    entry_point = gym.spec(env_id).entry_point
-    creator = load_env_creator(entry_point) if isinstance(entry_point, str) else entry_point
-    metadata = getattr(creator, "metadata", None)
+    metadata = getattr(env_creator(env_id), "metadata", None)
     return list(metadata.get("render_modes", [])) if isinstance(metadata, dict) else None
 
 

@@ -12,7 +12,7 @@ import tempfile
 from pathlib import Path
 from typing import Callable, Iterator
 
-from rlcore.errors import UserError, WriteFailed
+from rlcore.errors import UserError, WriteFailed, disk_error
 
 
 def writable_folder(folder: str | os.PathLike, what: str) -> Path:
@@ -61,6 +61,21 @@ def atomic_path(target: str | os.PathLike, then: str = "resume the run") -> Iter
     finally:
         if tmp.exists():
             tmp.unlink()
+
+
+@contextlib.contextmanager
+def library_writes(folder: str | os.PathLike) -> Iterator[None]:
+    """A library's failed write into ``folder`` raised as the OS error behind it (:func:`rlcore.errors.disk_error`),
+    for :func:`atomic_path` or the caller to name in one line; any other error passes as it is."""
+    try:
+        yield
+    except UserError:
+        raise
+    except Exception as exc:  # noqa: BLE001 (a library's own error type, turned into the OS error behind it)
+        reason = disk_error(exc, folder)
+        if reason is None or reason is exc:
+            raise
+        raise reason from None
 
 
 def _umask() -> int:

@@ -30,7 +30,8 @@ from typing import Callable
 import numpy as np
 
 from rlcore.algorithms.registry import family
-from rlcore.errors import UserError, WriteFailed, disk_error
+from rlcore.errors import UserError, WriteFailed
+from rlcore.files.atomic import library_writes
 from rlcore.hyperparams.allowed import flag, setting
 from rlcore.models.export_parity import (
     ABS_TOLERANCE,
@@ -227,12 +228,10 @@ def written(out_dir: Path):
     """A failed write under ``out_dir`` (ours or a library's) as one line naming it; an earlier export there
     is left whole (the new one is written beside it and moved in only when complete)."""
     try:
-        yield
-    except Exception as exc:  # noqa: BLE001 (a library's own error type, turned into the OS error behind it)
-        reason = disk_error(exc)
-        if reason is None or isinstance(exc, UserError):
-            raise
-        raise WriteFailed(out_dir, reason, then="export again") from None
+        with library_writes(out_dir.parent):
+            yield
+    except OSError as exc:
+        raise WriteFailed(out_dir, exc, then="export again") from None
 
 
 def _move_into_place(tmp: Path, out_dir: Path) -> None:

@@ -2,10 +2,7 @@
 to a small looping GIF (imageio's Pillow plugin), chosen by the file's suffix."""
 from __future__ import annotations
 
-import contextlib
-import errno
 import os
-import shutil
 from functools import partial
 from pathlib import Path
 
@@ -14,7 +11,7 @@ import imageio.v3 as iio
 import numpy as np
 
 from rlcore.errors import UserError
-from rlcore.files.atomic import atomic_path
+from rlcore.files.atomic import atomic_path, library_writes
 from rlcore.hyperparams.allowed import setting
 
 VIDEO_SUFFIXES = (".mp4", ".gif")
@@ -40,33 +37,19 @@ def gif_every(fps: int) -> int:
 class _Mp4:
     def __init__(self, path: Path, fps: int):
         # macro_block_size=1 keeps odd frame sizes (LunarLander is 600x400: fine either way)
-        # ffmpeg says nothing on the console: a failed write is our one line (written_by_ffmpeg)
+        # ffmpeg says nothing on the console: a failed write is our one line (library_writes)
         self.path = path
         self.writer = imageio.get_writer(path, fps=fps, codec="libx264", macro_block_size=1, ffmpeg_log_level="quiet")
         self.frames = 0
 
     def add(self, frame: np.ndarray) -> None:
-        with written_by_ffmpeg(self.path):
+        with library_writes(self.path.parent):
             self.writer.append_data(frame)
         self.frames += 1
 
     def close(self) -> None:
-        with written_by_ffmpeg(self.path):
+        with library_writes(self.path.parent):
             self.writer.close()
-
-
-@contextlib.contextmanager
-def written_by_ffmpeg(path: Path):
-    """ffmpeg's failures (a broken pipe, its log) as the OS error behind them: a full disk where the
-    folder has no room left, else the message's first line."""
-    try:
-        yield
-    except (OSError, RuntimeError, ValueError) as exc:
-        if isinstance(exc, OSError) and exc.errno not in (errno.EPIPE, None):
-            raise
-        if shutil.disk_usage(path.parent).free < 1 << 20:
-            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC)) from None
-        raise OSError(errno.EIO, (str(exc).strip().splitlines() or ["ffmpeg failed"])[0]) from None
 
 
 class _Gif:

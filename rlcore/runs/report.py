@@ -7,7 +7,6 @@ return, or for Mario the share of episodes that reached the flag. TensorFlow-fre
 """
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np

@@ -14,7 +14,6 @@ finished. TensorFlow-free.
 """
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np

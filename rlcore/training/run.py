@@ -22,7 +22,7 @@ from rlcore.environments.registry import get_experiment
 from rlcore.errors import UserError
 from rlcore.hyperparams.allowed import flag, resume_words, setting
 from rlcore.hyperparams.flags import apply_overrides, as_recorded, check_no_inert, check_same_run, from_dict, to_dict
-from rlcore.training.spec import CHECKPOINT_FILE, RunSpec, check_resumable
+from rlcore.training.spec import RunSpec, check_resumable, recorded_env
 
 
 def build_spec(experiment: str, algo: str, *, preset: str | None = None, seed: int | None = None,
@@ -96,12 +96,7 @@ def _experiment_of(experiment: str, run_dir: Path, resume: bool, env_kwargs: dic
     ``--env-kwargs`` may repeat, not change)."""
     if not resume:
         return get_experiment(experiment, env_kwargs=env_kwargs)
-    from rlcore.files.checkpoint import read_checkpoint_state
-
-    try:
-        record = read_checkpoint_state(run_dir / CHECKPOINT_FILE).get("env") or {}
-    except (UserError, OSError):
-        record = {}  # a missing or damaged checkpoint: check_resumable says so in its words
+    record = recorded_env(run_dir)
     recorded = record.get("env_kwargs") or {}
     if env_kwargs is not None and env_kwargs != recorded:
         raise UserError(f"--env-kwargs cannot change on a resume: the run in {run_dir} was started with "

@@ -18,6 +18,15 @@ RUNS_DIR = Path("runs")
 CHECKPOINT_FILE = "checkpoint.npz"
 
 
+def recorded_env(run_dir: str | Path) -> dict:
+    """The env a run's checkpoint records (a Gymnasium id's registration and ``--env-kwargs``), read quietly:
+    {} for a run without one, and for a missing or damaged checkpoint, whose resume reports it in its words."""
+    try:
+        return read_checkpoint_state(Path(run_dir) / CHECKPOINT_FILE).get("env") or {}
+    except (UserError, OSError, ValueError):
+        return {}
+
+
 @dataclass
 class RunSpec:
     """Everything that defines a training run (what ``main.py train`` parsed)."""

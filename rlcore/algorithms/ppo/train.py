@@ -64,9 +64,9 @@ def train(spec: RunSpec) -> Path:
         run = RolloutLoop(spec, envs)
     with envs, run.session.interruptible():
         while not run.session.should_stop():
-            log, seconds = run.collect()
-            losses = run.learn()
-            run.report(log, losses, {**seconds, "update_seconds": round(time.perf_counter() - run.learn_started, 3)})
+            log, collect_seconds = run.collect()
+            losses, update_seconds = run.learn()
+            run.report(log, losses, {"collect_seconds": collect_seconds, "update_seconds": update_seconds})
         run.keep_env_memory()  # the last checkpoint is written after the pool closes (session.conclude),
         # so its reading is taken here, while the pool still answers
     # the model's story starts with the run whose weights it started from
@@ -105,15 +105,15 @@ class RolloutLoop:
         self.losses = {name: float("nan") for name in UPDATE_NAMES}  # CSV columns exist from the first row
         # a resumed run starts fresh episodes, reseeded from its episode count
         self.obs, _ = envs.reset(seed=self.session.fresh_env_seeds(cfg.num_envs))
-        self.learn_started = 0.0
 
     def checkpoint(self) -> None:
         checkpoints.save(self.session, self.agent, self.rng, env_arrays=self.env_kept, rollouts=self.rollouts,
                          init_from=self.parent, **{**self.lr.state(), **self.entropy.state()})  # one key, the best share
 
-    def collect(self) -> tuple[RolloutLog, dict]:
+    def collect(self) -> tuple[RolloutLog, float]:
         """``n_steps`` steps of every env into the buffers; a truncated episode's final observation valued
-        in one batched call per step; each ended episode's row to the session."""
+        in one batched call per step; each ended episode's row to the session. Returns the rollout's log
+        and its seconds."""
         log, truncated_values, started = RolloutLog(self.exp), {}, time.perf_counter()
         buf, session, n = self.buf, self.session, self.cfg.num_envs
         for step in range(self.cfg.n_steps):
@@ -136,15 +136,15 @@ class RolloutLoop:
             self.obs = next_obs
             session.advance(n)
         buf.close(self.agent.values(self.obs), truncated_values)
-        return log, {"collect_seconds": round(time.perf_counter() - started, 3)}  # where a rollout's time goes
+        return log, round(time.perf_counter() - started, 3)  # where a rollout's time goes
 
-    def learn(self) -> dict:
-        """One PPO update on the rollout; a NaN loss ends the run with one line."""
-        self.learn_started = time.perf_counter()
+    def learn(self) -> tuple[dict, float]:
+        """One PPO update on the rollout (a NaN loss ends the run with one line); its losses and seconds."""
+        started = time.perf_counter()
         with reported_divergence(self.session, "PPO", "lower the learning rate"):
             self.losses = self.agent.update(*self.buf.arrays(), self.rng)
         self.rollouts += 1
-        return self.losses
+        return self.losses, round(time.perf_counter() - started, 3)
 
     def report(self, log: RolloutLog, losses: dict, seconds: dict) -> None:
         """The rollout's row and console line, the halvings the share has earned, a checkpoint when due."""
