@@ -93,15 +93,16 @@ def run_status(name: str, folders: Path = HERE) -> str:
 
 def _progress(metrics: Path) -> str:
     """Env steps and episodes so far, and the flag in the last 100 episodes from the level's start."""
-    import csv
+    from rlcore.errors import UserError
+    from rlcore.files.csv_tables import read_table  # a resume's reader: damaged rows left out
 
     try:
-        with open(metrics, newline="", encoding="utf-8", errors="replace") as f:
-            rows = list(csv.DictReader(f))
-    except OSError:
-        return "no metrics.csv"
-    if not rows:
+        table, _ = read_table(metrics)
+    except (OSError, UserError):
+        return "no readable metrics.csv"
+    if len(table) < 2:
         return "no episode yet"
+    rows = [dict(zip(table[0], row)) for row in table[1:]]
     counted = [r for r in rows if r.get("restarted") in (None, "", "0", "0.0")][-100:]
     flags = sum(r.get("success") in ("1", "1.0", "True") for r in counted)
     return (f"{int(float(rows[-1]['env_steps'])):,} env steps, {len(rows):,} episodes, "
