@@ -14,7 +14,7 @@ from rlcore.host.extras import install_command, require
 
 ROOT = Path(__file__).resolve().parents[1]
 OPTIONAL = ["nes_py", "gym_super_mario_bros", "cv2", "pybullet", "pybullet_data", "pybullet_utils", "ray",
-            "rliable", "tf2onnx", "onnx", "onnxruntime"]
+            "rliable", "tf2onnx", "onnx", "onnxruntime", "ale_py", "mujoco"]
 
 
 def run_without_extras(*args: str, cwd: Path) -> subprocess.CompletedProcess:
@@ -35,6 +35,9 @@ def test_core_commands_work_without_any_extra(args, tmp_path):
     (["train", "mario_ppo", "ppo", "--steps", "10"], "Mario needs the mario extra: pip install -e '.[mario]'"),
     (["train", "minitaur", "sac", "--steps", "10"],
      "Minitaur needs the minitaur extra: pip install -e '.[minitaur]'"),
+    (["train", "ALE/Pong-v5", "dqn", "--steps", "10"], "Atari (ALE/* ids) needs the atari extra: pip install -e '.[atari]'"),
+    (["train", "HalfCheetah-v5", "sac", "--steps", "10"],
+     "HalfCheetah-v5 (MuJoCo) needs the mujoco extra: pip install -e '.[mujoco]'"),
     (["sweep", "lunar_lander", "dqn", "--seeds", "0", "--steps", "10"],
      "The sweep command needs the sweep extra: pip install -e '.[sweep]'"),
     (["report", "no_such_sweep"], "The report command needs the sweep extra: pip install -e '.[sweep]'"),

@@ -76,6 +76,18 @@ def needs_vector_observations(observation_space: gymnasium.Space) -> str | None:
     return None
 
 
+def needs_vectors_or_images(observation_space: gymnasium.Space) -> str | None:
+    if not (is_vector(observation_space) or is_image(observation_space)):
+        return (f"it needs vector observations (a 1-D Box) or uint8 images (H x W x C), and the env's are "
+                f"{observation_space}")
+    return None
+
+
 def discrete_on_vectors(observation_space: gymnasium.Space, action_space: gymnasium.Space) -> str | None:
-    """The DQN family's and A2C's fit: discrete actions, vector observations."""
+    """Discrete actions, vector observations (an MLP-only family, such as the tests' toy one)."""
     return needs_discrete_actions(action_space) or needs_vector_observations(observation_space)
+
+
+def discrete_on_vectors_or_images(observation_space: gymnasium.Space, action_space: gymnasium.Space) -> str | None:
+    """The DQN family's, A2C's and PPO's fit: discrete actions; vectors (MLP) or images (CNN)."""
+    return needs_discrete_actions(action_space) or needs_vectors_or_images(observation_space)

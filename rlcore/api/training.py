@@ -38,7 +38,7 @@ def train(env: str, algo: str, *, preset: str | None = None, seed: int = 0,
     ``lr=5e-4, hidden=(128, 128)``; each is checked as the CLI checks it. ``callback(row, table)``
     sees every logged row. ``progress``: the progress bar and the summary lines.
     """
-    from rlcore.host.extras import require_experiment
+    from rlcore.environments.registry import require_experiment
     from rlcore.host.quiet import load_tensorflow
     from rlcore.training.run import build_spec, check_new_run_dir
     from rlcore.training.spec import new_run_dir
@@ -76,7 +76,7 @@ def resume(run: str | os.PathLike[str] | Run, *, episodes: int | None = None, st
     :class:`UserError`.
     """
     from rlcore.files.checkpoint import read_checkpoint_state
-    from rlcore.host.extras import require_experiment
+    from rlcore.environments.registry import require_experiment
     from rlcore.host.quiet import load_tensorflow
     from rlcore.hyperparams.flags import resuming_changes
     from rlcore.training.run import build_spec

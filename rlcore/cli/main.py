@@ -127,7 +127,7 @@ def main(argv: list[str] | None = None) -> int:
         if args.command in ("train", "evaluate", "render", "export"):
             from rlcore.training.stopping import guard_terminal_streams
             guard_terminal_streams()  # a terminal that closes (SIGHUP) must not cost a run its checkpoint
-            from rlcore.host.extras import require_experiment
+            from rlcore.environments.registry import require_experiment
             register_recorded_env(getattr(args, "model", None))
             require_experiment(args.experiment)  # a missing extra (mario, minitaur): one line, no run folder
             from rlcore.host.quiet import load_tensorflow

@@ -6,12 +6,12 @@
 
 What fits (the agents read nothing of an env but its spaces):
 
-    dqn, ddqn, dueling_dqn, dueling_ddqn, a2c   Discrete actions, vector observations (a 1-D Box)
-    ppo                                         Discrete actions, vector observations (MLP body) or
-                                                uint8 images H x W x C (CNN body)
+    dqn, ddqn, dueling_dqn, dueling_ddqn,       Discrete actions, vector observations (a 1-D Box, MLP
+    a2c, ppo                                    body) or uint8 images H x W x C (CNN body)
     sac                                         Box actions with finite bounds (rescaled to [-1, 1],
                                                 the range of its tanh actor), vector observations
 
+``ALE/*`` ids (the ``atari`` extra) get the DQN papers' preprocessing (:mod:`rlcore.environments.atari`).
 A Discrete observation (FrozenLake's cell, Taxi's state number) is given to the networks one-hot, as a
 vector of n zeros and a one (Stable-Baselines3 does the same); the exported networks take that vector.
 
@@ -31,9 +31,13 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from rlcore.algorithms.registry import FAMILIES, family
+from rlcore.environments import atari
 from rlcore.environments.env_kwargs import check_env_kwargs, env_creator
 from rlcore.environments.experiment import AlgoSpec, Experiment
+from rlcore.environments.remote import RemoteEnv, draws_with_opengl
 from rlcore.errors import UserError
+from rlcore.host.extras import missing_extra_message, require
+from rlcore.host.quiet import filtered_stderr, route_mujoco_warnings
 
 if TYPE_CHECKING:
     import gymnasium
@@ -61,6 +65,8 @@ def gym_spec(name: str) -> EnvSpec:
     import gymnasium as gym
 
     module, env_id = split_module(name)
+    if atari.is_atari(env_id):
+        atari.register_atari()
     if module is not None:
         try:
             importlib.import_module(module)
@@ -88,6 +94,9 @@ def register_from_record(record: dict) -> None:
     import gymnasium as gym
 
     env_id, entry_point = record.get("gymnasium_id"), record.get("entry_point")
+    if env_id and atari.is_atari(env_id):
+        atari.register_atari()  # ale-py registers its own
+        return
     if not env_id or env_id in gym.registry or not isinstance(entry_point, str):
         return
     gym.register(env_id, entry_point=entry_point, kwargs=record.get("kwargs") or {},
@@ -96,15 +105,20 @@ def register_from_record(record: dict) -> None:
 
 
 def make_gym_env(render_mode: str | None = None, max_episode_steps: int | None = None, *, name: str,
-                 rescale_actions: bool = False, env_kwargs: dict | None = None) -> gymnasium.Env:
+                 rescale_actions: bool = False, env_kwargs: dict | None = None,
+                 in_worker: bool = False) -> gymnasium.Env:
     """The env ``name`` (``module:id`` imports the module first) with its registered time limit unless
     ``max_episode_steps`` is given, built with ``env_kwargs`` (``--env-kwargs``); SAC's envs get their Box
-    actions rescaled from [-1, 1]."""
+    actions rescaled from [-1, 1]. A MuJoCo env asked for frames runs in a worker process
+    (:mod:`rlcore.environments.remote`)."""
     import gymnasium as gym
 
     module, env_id = split_module(name)
     if module is not None:
         importlib.import_module(module)  # a spawned pool worker registers the user's env here
+    if render_mode and not in_worker and draws_with_opengl(gym_spec(name).entry_point):
+        return RemoteEnv(partial(make_gym_env, render_mode, max_episode_steps, name=name, in_worker=True,
+                                 rescale_actions=rescale_actions, env_kwargs=env_kwargs), env_id)
     env = _make(env_id, render_mode, max_episode_steps, env_kwargs or {})
     if isinstance(env.observation_space, gym.spaces.Discrete):
         env = OneHotObservation(env)
@@ -116,19 +130,32 @@ def make_gym_env(render_mode: str | None = None, max_episode_steps: int | None =
 def _make(env_id: str, render_mode: str | None, max_episode_steps: int | None, env_kwargs: dict) -> gymnasium.Env:
     """``gym.make``, given ``render_mode`` only when frames are wanted (an env class may take no such
     argument, as many tutorials write them), and only a mode the env declares; else one line."""
-    import gymnasium as gym
-
+    if atari.is_atari(env_id):
+        atari.register_atari()  # in a spawned pool worker too
+    make = atari.make_atari if atari.is_atari(env_id) else _gym_make
     if render_mode is None:
-        return gym.make(env_id, max_episode_steps=max_episode_steps, **env_kwargs)
+        return make(env_id, None, max_episode_steps, env_kwargs)
     modes = _declared_modes(env_id)
     if modes is not None and render_mode not in modes:
         raise UserError(f"{env_id} cannot render {render_mode} frames: its env declares "
                         f"{', '.join(modes) or 'no render mode'} (metadata['render_modes']), so there is no "
                         "video or GIF of it; evaluate works without frames")
     try:
-        return gym.make(env_id, max_episode_steps=max_episode_steps, render_mode=render_mode, **env_kwargs)
+        return make(env_id, render_mode, max_episode_steps, env_kwargs)
     except TypeError as exc:
         raise UserError(f"{env_id} cannot render: its env class takes no render_mode argument ({exc})") from None
+
+
+def _gym_make(env_id: str, render_mode: str | None, max_episode_steps: int | None, env_kwargs: dict) -> gymnasium.Env:
+    """``gym.make``, with what an env's C library prints on every build dropped (:data:`quiet.NOISE`)."""
+    import gymnasium as gym
+
+    if draws_with_opengl(gym.spec(env_id).entry_point):
+        require("mujoco", f"{env_id} (MuJoCo)")
+        route_mujoco_warnings()
+    with filtered_stderr():
+        return gym.make(env_id, max_episode_steps=max_episode_steps,
+                    **({"render_mode": render_mode} if render_mode else {}), **env_kwargs)
 
 
 def _declared_modes(env_id: str) -> list[str] | None:
@@ -191,12 +218,23 @@ def gym_experiment(name: str, env_kwargs: dict | None = None) -> Experiment:
 _BUILT: dict[tuple[str, str, tuple[str, ...]], Experiment] = {}
 
 
+def _missing_dependency(spec: EnvSpec, exc: Exception) -> str:
+    """Gymnasium's "not installed" as this package's install line where an extra brings it."""
+    if draws_with_opengl(spec.entry_point):
+        return missing_extra_message(f"{spec.id} (MuJoCo)", "mujoco")
+    return f"{spec.id} needs a package that is not installed: {exc}"
+
+
 def _build(name: str, env_kwargs: dict) -> Experiment:
+    import gymnasium as gym
+
     spec = gym_spec(name)
     if env_kwargs:
         check_env_kwargs(spec.id, env_kwargs)
     try:
         env = make_gym_env(name=name, env_kwargs=env_kwargs)
+    except gym.error.DependencyNotInstalled as exc:
+        raise UserError(_missing_dependency(spec, exc)) from None
     except (TypeError, ValueError, AssertionError) as exc:  # a value the env's own checks refuse
         if not env_kwargs:
             raise
@@ -229,7 +267,8 @@ def _build(name: str, env_kwargs: dict) -> Experiment:
         env_record={"gymnasium_id": spec.id, "entry_point": entry_point,
                     "kwargs": _jsonable(spec.kwargs), "max_episode_steps": spec.max_episode_steps,
                     "reward_threshold": spec.reward_threshold, "actions_rescaled_to": [-1, 1] if rescale else None,
-                    "observations_one_hot": one_hot_obs, **({"env_kwargs": env_kwargs} if env_kwargs else {})},
+                    "observations_one_hot": one_hot_obs, **({"env_kwargs": env_kwargs} if env_kwargs else {}),
+                    **({"atari_preprocessing": atari.record()} if atari.is_atari(spec.id) else {})},
     )
 
 

@@ -7,6 +7,8 @@ import importlib
 from rlcore.environments import gym_experiment
 from rlcore.environments.experiment import Experiment
 from rlcore.errors import UserError
+from rlcore.host.extras import experiment_needs, require
+from rlcore.host.quiet import filtered_stderr
 
 EXPERIMENT_MODULES = {
     "lunar_lander": "lunar_lander.experiment",
@@ -46,3 +48,13 @@ def get_experiment(name: str, env_record: dict | None = None, env_kwargs: dict |
         gym_experiment.register_from_record(env_record)
         env_kwargs = env_kwargs or env_record.get("env_kwargs")
     return gym_experiment.gym_experiment(name, env_kwargs)
+
+
+def require_experiment(experiment: str) -> None:
+    """Raise the one-line :class:`UserError` of :func:`rlcore.host.extras.require` if the extra that
+    ``experiment`` declared is not installed; unknown names are left to :func:`get_experiment`'s error."""
+    get_experiment(experiment)  # imports the experiment package, which declares its needs
+    what, extra, modules = experiment_needs(experiment)
+    with filtered_stderr():  # pybullet prints its build time on import
+        for module in modules:
+            require(module, what, extra)

@@ -51,7 +51,7 @@ class IgnoringStopSignals:
         return self.make_env()
 
 
-def _start_method() -> str:
+def start_method() -> str:
     return "forkserver" if "forkserver" in multiprocessing.get_all_start_methods() else "spawn"
 
 
@@ -80,7 +80,7 @@ class EnvPool:
         autoreset = gym.vector.AutoresetMode.SAME_STEP
         if mode == "processes":
             self.envs = gym.vector.AsyncVectorEnv([IgnoringStopSignals(fn) for fn in env_fns],
-                                                  context=_start_method(), daemon=True,
+                                                  context=start_method(), daemon=True,
                                                   autoreset_mode=autoreset)
         else:
             self.envs = gym.vector.SyncVectorEnv(env_fns, autoreset_mode=autoreset)

@@ -16,6 +16,7 @@ from rlcore.errors import UserError
 EXTRA_OF = {
     "nes_py": "mario", "gym_super_mario_bros": "mario", "cv2": "mario",
     "pybullet": "minitaur", "pybullet_data": "minitaur", "pybullet_utils": "minitaur",
+    "ale_py": "atari", "mujoco": "mujoco",
     "ray": "sweep", "rliable": "sweep",
     "tf2onnx": "export", "onnx": "export", "onnxruntime": "export", "ai_edge_litert": "export",
 }
@@ -55,18 +56,11 @@ _EXPERIMENT_NEEDS: dict[str, tuple[str, str, tuple[str, ...]]] = {}
 
 def declare(experiment: str, what: str, extra: str, modules: tuple[str, ...]) -> None:
     """An experiment package says which extra its env needs (``mario_ppo``: the mario extra), so a
-    command can check it before any run folder exists; see :func:`require_experiment`."""
+    command can check it before any run folder exists
+    (:func:`rlcore.environments.registry.require_experiment`)."""
     _EXPERIMENT_NEEDS[experiment] = (what, extra, tuple(modules))
 
 
-def require_experiment(experiment: str) -> None:
-    """Raise the one-line :class:`UserError` of :func:`require` if the extra that ``experiment``
-    declared is not installed; unknown names are left to the registry's own error."""
-    from rlcore.environments.registry import get_experiment
-    from rlcore.host.quiet import filtered_stderr
-
-    get_experiment(experiment)  # imports the experiment package, which declares its needs
-    what, extra, modules = _EXPERIMENT_NEEDS.get(experiment, ("", "", ()))
-    with filtered_stderr():  # pybullet prints its build time on import
-        for module in modules:
-            require(module, what, extra)
+def experiment_needs(experiment: str) -> tuple[str, str, tuple[str, ...]]:
+    """(what, extra, modules) an experiment package declared; empty for one that needs nothing more."""
+    return _EXPERIMENT_NEEDS.get(experiment, ("", "", ()))

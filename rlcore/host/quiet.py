@@ -28,6 +28,9 @@ NOISE = re.compile("|".join([
     r"^pybullet build time: ",
     r"^Token authentication is enabled for this Ray cluster\.",  # local Ray keeps its token; no news
     r"^INFO: Created TensorFlow Lite XNNPACK delegate for CPU\.$",  # LiteRT, each interpreter (export check)
+    r"^A\.L\.E: Arcade Learning Environment \(version [^)]*\)$",  # ale-py's banner, each import
+    r"^\[Powered by Stella\]$",
+    r"compiler attribute 'settotalmass' is deprecated",  # MuJoCo 4 on Gymnasium's own model files
 ]))
 
 # SDL (pygame, which Gymnasium's classic-control and Box2D envs draw their frames with) starts a video
@@ -35,10 +38,24 @@ NOISE = re.compile("|".join([
 # no window can open anyway, and frames for a video need none, so SDL gets its dummy driver
 if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")  # (macOS and Windows have displays without DISPLAY)
+    # MuJoCo draws frames through OpenGL: without a display, through EGL (headless GPUs and Mesa alike);
+    # MUJOCO_GL=osmesa where EGL is missing
+    os.environ.setdefault("MUJOCO_GL", "egl")
 
 
 def keep(line: str) -> bool:
     return not NOISE.search(line.rstrip("\n"))
+
+
+def route_mujoco_warnings() -> None:
+    """MuJoCo prints each warning and appends it to ``MUJOCO_LOG.TXT`` in the working folder; here a
+    warning goes to stderr once, unless it is :data:`NOISE`, and no log file is left behind."""
+    import mujoco
+
+    def warn(message: str) -> None:
+        if keep(message):
+            print(f"MuJoCo warning: {message}", file=sys.stderr)
+    mujoco.set_mju_user_warning(warn)
 
 
 def _flush_c_stdio() -> None:

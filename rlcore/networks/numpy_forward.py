@@ -94,3 +94,31 @@ class NumpyForward:
         if len(self._outputs) == 1:
             return values[self._outputs[0]]
         return [values[i] for i in self._outputs]
+
+
+class CompiledForward:
+    """The same interface through one compiled call of the model itself: for a CNN, which is no job for
+    numpy. ``load`` has nothing to copy, the model's own variables are the ones training updates."""
+
+    def __init__(self, model: keras.Model):
+        import tensorflow as tf
+
+        dtype = model.inputs[0].dtype
+        self.dtype = np.dtype(dtype if isinstance(dtype, str) else dtype.name)
+        self._call = tf.function(lambda obs: model(obs), input_signature=[
+            tf.TensorSpec([None, *model.inputs[0].shape[1:]], tf.as_dtype(self.dtype))])
+        self._single = len(model.outputs) == 1
+
+    def load(self, weights) -> None:
+        pass
+
+    def __call__(self, obs: np.ndarray):
+        out = self._call(np.asarray(obs, self.dtype))
+        return np.asarray(out) if self._single else [np.asarray(o) for o in out]
+
+
+def acting_forward(model: keras.Model) -> NumpyForward | CompiledForward:
+    """:class:`NumpyForward` for a model made of the layers it knows (the MLPs), else
+    :class:`CompiledForward`."""
+    known = all(isinstance(layer, keras.layers.InputLayer) or type(layer) in STEPS for layer in model.layers)
+    return NumpyForward(model) if known else CompiledForward(model)

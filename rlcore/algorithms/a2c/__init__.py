@@ -4,7 +4,7 @@ May import: rlcore.algorithms' shared modules, networks, hyperparams, environmen
 models, runs, sweeps, api or cli.
 """
 from rlcore.algorithms.a2c.config import A2CConfig
-from rlcore.algorithms.family import Family, discrete_on_vectors
+from rlcore.algorithms.family import Family, discrete_on_vectors_or_images
 
 
 def run_training(spec):
@@ -16,7 +16,7 @@ def run_training(spec):
 def build_agent(observation_space, action_space, cfg):
     from rlcore.algorithms.a2c.agent import A2CAgent
 
-    return A2CAgent(observation_space.shape[0], int(action_space.n), cfg)
+    return A2CAgent(observation_space.shape, int(action_space.n), cfg)
 
 
 def load_policy(path, obs_shape, action_space, cfg):
@@ -28,5 +28,5 @@ def load_policy(path, obs_shape, action_space, cfg):
 FAMILY = Family(
     kind="a2c", description="advantage actor-critic with n-step returns",
     config=A2CConfig, train=run_training, build_agent=build_agent, policy_file="actor.h5", load_policy=load_policy,
-    export_output="action probabilities pi(a|s) (greedy action = argmax)", misfit=discrete_on_vectors,
+    export_output="action probabilities pi(a|s) (greedy action = argmax)", misfit=discrete_on_vectors_or_images,
     variants={"a2c": ("A2C", {})}, stochastic=True, env_pool=True)

@@ -20,18 +20,19 @@ from keras import layers
 
 from rlcore.algorithms.a2c.config import A2CConfig
 from rlcore.algorithms.advantages import gae
-from rlcore.networks.numpy_forward import NumpyForward
+from rlcore.networks.bodies import as_shape, features, obs_dtype, observation_input
+from rlcore.networks.numpy_forward import acting_forward
 from rlcore.networks.sampling import sample_categorical
 from rlcore.networks.saving import save_keras_model
 
 _PROB_FLOOR = 1e-8  # keeps log(p) finite when the softmax saturates
 
 
-def _mlp(obs_dim: int, hidden, out_units: int, out_activation, name: str) -> keras.Model:
-    return keras.Sequential(
-        [keras.Input((obs_dim,), name="obs")]
-        + [layers.Dense(u, activation="relu", name=f"hidden_{i}") for i, u in enumerate(hidden)]
-        + [layers.Dense(out_units, activation=out_activation, name="output")], name=name)
+def _network(obs_shape: tuple, hidden, out_units: int, out_activation, name: str) -> keras.Model:
+    """The MLP ``hidden`` (vectors) or the CNN (images, :mod:`rlcore.networks.bodies`), then ``output``."""
+    obs = observation_input(obs_shape)
+    output = layers.Dense(out_units, activation=out_activation, name="output")(features(obs, obs_shape, hidden))
+    return keras.Model(obs, output, name=name)
 
 
 def _apply(opt, model, tape, loss, max_grad_norm: float):
@@ -44,15 +45,15 @@ def _apply(opt, model, tape, loss, max_grad_norm: float):
 class Actor:
     """Policy network pi(a|s): MLP ending in softmax."""
 
-    def __init__(self, state_dim: int, action_dim: int, lr: float, hidden=(256, 256), max_grad_norm=0.0):
-        self.state_dim, self.action_dim, self.hidden = state_dim, action_dim, hidden
+    def __init__(self, state_dim: int | tuple, action_dim: int, lr: float, hidden=(256, 256), max_grad_norm=0.0):
+        self.state_dim, self.action_dim, self.hidden = as_shape(state_dim), action_dim, hidden
         self.max_grad_norm = max_grad_norm
         self.model = self.create_model()
         self.opt = keras.optimizers.Adam(lr)
         self.opt.build(self.model.trainable_variables)
 
     def create_model(self) -> keras.Model:
-        return _mlp(self.state_dim, self.hidden, self.action_dim, "softmax", "actor")
+        return _network(self.state_dim, self.hidden, self.action_dim, "softmax", "actor")
 
     @staticmethod
     def compute_loss(actions, probs, advantages, entropy_coef: float = 0.0):
@@ -75,14 +76,14 @@ class Actor:
 class Critic:
     """State-value network V(s)."""
 
-    def __init__(self, state_dim: int, lr: float, hidden=(256, 256), max_grad_norm=0.0):
-        self.state_dim, self.hidden, self.max_grad_norm = state_dim, hidden, max_grad_norm
+    def __init__(self, state_dim: int | tuple, lr: float, hidden=(256, 256), max_grad_norm=0.0):
+        self.state_dim, self.hidden, self.max_grad_norm = as_shape(state_dim), hidden, max_grad_norm
         self.model = self.create_model()
         self.opt = keras.optimizers.Adam(lr)
         self.opt.build(self.model.trainable_variables)
 
     def create_model(self) -> keras.Model:
-        return _mlp(self.state_dim, self.hidden, 1, "linear", "critic")
+        return _network(self.state_dim, self.hidden, 1, "linear", "critic")
 
     @staticmethod
     def compute_loss(v_pred, td_targets):
@@ -99,13 +100,13 @@ class Critic:
 class A2CAgent:
     """Actor + Critic, sampling actions from pi and updating both once per rollout."""
 
-    def __init__(self, obs_dim: int, n_actions: int, cfg: A2CConfig):
-        self.obs_dim, self.n_actions, self.cfg = obs_dim, n_actions, cfg
-        self.actor = Actor(obs_dim, n_actions, cfg.actor_lr, cfg.actor_hidden, cfg.max_grad_norm)
-        self.critic = Critic(obs_dim, cfg.critic_lr, cfg.critic_hidden, cfg.max_grad_norm)
-        self.policy = NumpyForward(self.actor.model)  # acting's numpy copy of the actor
+    def __init__(self, obs_shape: int | tuple, n_actions: int, cfg: A2CConfig):
+        self.obs_shape, self.n_actions, self.cfg = as_shape(obs_shape), n_actions, cfg
+        self.actor = Actor(self.obs_shape, n_actions, cfg.actor_lr, cfg.actor_hidden, cfg.max_grad_norm)
+        self.critic = Critic(self.obs_shape, cfg.critic_lr, cfg.critic_hidden, cfg.max_grad_norm)
+        self.policy = acting_forward(self.actor.model)  # acting's numpy copy of an MLP actor
         t, n = cfg.n_steps, cfg.num_envs
-        obs_spec = tf.TensorSpec([t, n, obs_dim], tf.float32)
+        obs_spec = tf.TensorSpec([t, n, *self.obs_shape], tf.as_dtype(obs_dtype(self.obs_shape)))
         vec = tf.TensorSpec([t, n], tf.float32)
         self._update = tf.function(self._update_graph, input_signature=[
             obs_spec, tf.TensorSpec([t, n], tf.int32), vec, obs_spec, vec, vec])
@@ -130,9 +131,9 @@ class A2CAgent:
     def _update_graph(self, obs, actions, rewards, next_obs, terminated, dones):
         cfg = self.cfg
         t, n = cfg.n_steps, cfg.num_envs
-        flat_obs = tf.reshape(obs, [t * n, self.obs_dim])
+        flat_obs = tf.reshape(obs, [t * n, *self.obs_shape])
         values = tf.reshape(self.critic.model(flat_obs), [t, n])
-        next_values = tf.reshape(self.critic.model(tf.reshape(next_obs, [t * n, self.obs_dim])), [t, n])
+        next_values = tf.reshape(self.critic.model(tf.reshape(next_obs, [t * n, *self.obs_shape])), [t, n])
         advantages = gae(rewards * cfg.reward_scale, values, next_values, terminated, dones,
                          cfg.gamma, cfg.gae_lambda)
         td_targets = tf.reshape(advantages + values, [t * n])

@@ -14,6 +14,7 @@ import numpy as np
 
 from rlcore.algorithms.a2c.agent import A2CAgent
 from rlcore.environments.vector import EnvPool, bootstrap_observations
+from rlcore.networks.bodies import obs_dtype
 from rlcore.training import checkpoints
 from rlcore.training.divergence import reported_divergence
 from rlcore.training.session import TrainingSession
@@ -26,8 +27,8 @@ def train(spec: RunSpec) -> Path:
     make_env = partial(spec.experiment.make_env, max_episode_steps=cfg.max_episode_steps or None)
     envs = EnvPool([make_env] * cfg.num_envs, mode=cfg.vec)
     with envs.closed_on_error():  # a start that fails (a damaged checkpoint, say) ends them quietly
-        obs_dim, n_actions = envs.single_observation_space.shape[0], int(envs.single_action_space.n)
-        agent = A2CAgent(obs_dim, n_actions, cfg)
+        obs_shape, n_actions = envs.single_observation_space.shape, int(envs.single_action_space.n)
+        agent = A2CAgent(obs_shape, n_actions, cfg)
         rng = np.random.default_rng(spec.seed)
 
         state, arrays = checkpoints.restore(spec, agent, rng)
@@ -37,8 +38,8 @@ def train(spec: RunSpec) -> Path:
             checkpoints.save(session, agent, rng)
 
         t, n = cfg.n_steps, cfg.num_envs
-        buf_obs = np.zeros((t, n, obs_dim), np.float32)
-        buf_next = np.zeros((t, n, obs_dim), np.float32)
+        buf_obs = np.zeros((t, n, *obs_shape), obs_dtype(obs_shape))  # frames stay uint8
+        buf_next = np.zeros_like(buf_obs)
         buf_actions = np.zeros((t, n), np.int32)
         buf_rewards, buf_term, buf_done = (np.zeros((t, n), np.float32) for _ in range(3))
         running = np.zeros(n)

@@ -10,7 +10,7 @@ import numpy as np
 
 from rlcore.algorithms.dqn.agent import DQNAgent
 from rlcore.algorithms.off_policy import run_episodes
-from rlcore.algorithms.replay import ReplayMemory
+from rlcore.algorithms.replay import replay_memory
 from rlcore.training import checkpoints
 from rlcore.training.episodes import episode_means
 from rlcore.training.session import TrainingSession
@@ -22,9 +22,8 @@ def train(spec: RunSpec) -> Path:
     cfg = spec.config
     keras.utils.set_random_seed(spec.seed)
     env = spec.experiment.make_env(max_episode_steps=cfg.max_episode_steps or None)
-    obs_dim, n_actions = env.observation_space.shape[0], int(env.action_space.n)
-    agent = DQNAgent(obs_dim, n_actions, cfg)
-    memory = ReplayMemory(cfg.buffer_size, (obs_dim,))
+    agent = DQNAgent(env.observation_space.shape, int(env.action_space.n), cfg)
+    memory = replay_memory(cfg.buffer_size, env)
     rng = np.random.default_rng(spec.seed)
     state, arrays = checkpoints.restore(spec, agent, rng, memory)
     session = TrainingSession(spec, state, resumed_arrays=arrays)

@@ -3,7 +3,7 @@
 May import: rlcore.algorithms' shared modules, networks, hyperparams, environments.vector, training; never
 models, runs, sweeps, api or cli.
 """
-from rlcore.algorithms.family import Family, is_image, is_vector, needs_discrete_actions
+from rlcore.algorithms.family import Family, discrete_on_vectors_or_images
 from rlcore.algorithms.ppo.config import PPOConfig
 
 
@@ -32,18 +32,9 @@ def acting_network(model):
     return keras.Model(model.inputs[0], model.outputs[0], name="policy")
 
 
-def misfit(observation_space, action_space):
-    if reason := needs_discrete_actions(action_space):
-        return reason
-    if not (is_vector(observation_space) or is_image(observation_space)):
-        return ("it needs vector observations (a 1-D Box) or uint8 images (H x W x C), and the env's "
-                f"are {observation_space}")
-    return None
-
-
 FAMILY = Family(
     kind="ppo", description="PPO with a clipped surrogate and GAE; an MLP body, or a CNN for images",
     config=PPOConfig, train=run_training, build_agent=build_agent, policy_file="actor_critic.h5", load_policy=load_policy,
-    export_output="policy logits, pi = softmax(logits) (greedy action = argmax)", misfit=misfit,
+    export_output="policy logits, pi = softmax(logits) (greedy action = argmax)", misfit=discrete_on_vectors_or_images,
     acting_network=acting_network, variants={"ppo": ("PPO (MLP body; CNN for images)", {})},
     stochastic=True, env_pool=True)

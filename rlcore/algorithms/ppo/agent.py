@@ -35,20 +35,12 @@ from rlcore.algorithms.advantages import gae
 from rlcore.algorithms.ppo.config import PPOConfig
 from rlcore.errors import UserError
 from rlcore.host.cpu import bfloat16_refusal, cpu_flags
+from rlcore.networks.bodies import cnn_features, is_image, mlp_features, obs_dtype, observation_input
 from rlcore.networks.sampling import sample_categorical, softmax
 from rlcore.networks.saving import save_keras_model
 
 MODEL_FILE = "actor_critic.h5"
 _QUIRK_EPS = 1e-3  # the article's constant in pi / (pi_old + 1e-3) and log(pi + 1e-3)
-
-
-def is_image(obs_shape: tuple) -> bool:
-    """Frame stacks (H x W x C, uint8) go through the CNN; anything flat through the MLPs."""
-    return len(obs_shape) == 3
-
-
-def obs_dtype(obs_shape: tuple) -> np.dtype:
-    return np.dtype(np.uint8) if is_image(obs_shape) else np.dtype(np.float32)
 
 
 def build_actor_critic(obs_shape: tuple, n_actions: int, precision: str = "float32",
@@ -64,12 +56,7 @@ def build_mlp_actor_critic(obs_shape: tuple, n_actions: int, hidden: tuple[int, 
     classic control), so the value loss does not pull on the policy's features. Outputs
     ``[logits, value]`` like the CNN model."""
     obs = keras.Input(obs_shape, dtype="float32", name="obs")
-    tower = {}
-    for head in ("policy", "value"):
-        x = obs
-        for i, units in enumerate(hidden):
-            x = layers.Dense(units, activation="tanh", name=f"{head}_hidden_{i}")(x)
-        tower[head] = x
+    tower = {head: mlp_features(obs, hidden, "tanh", prefix=f"{head}_") for head in ("policy", "value")}
     logits = layers.Dense(n_actions, name="policy_logits")(tower["policy"])
     value = layers.Dense(1, name="value")(tower["value"])
     return keras.Model(obs, [logits, value], name="actor_critic")
@@ -85,12 +72,8 @@ def build_cnn_actor_critic(obs_shape: tuple, n_actions: int, precision: str = "f
     if reason := bfloat16_refusal(precision, cpu_flags()):
         raise UserError(reason)
     body = "mixed_bfloat16" if precision == "bfloat16" else "float32"
-    frames = keras.Input(obs_shape, dtype="uint8", name="frames")
-    x = layers.Rescaling(1.0 / 255.0, name="to_unit", dtype=body)(frames)
-    for i in range(4):
-        x = layers.Conv2D(32, 3, strides=2, padding="same", activation="relu", name=f"conv_{i}", dtype=body)(x)
-    x = layers.Flatten(name="flatten", dtype=body)(x)
-    x = layers.Dense(512, activation="relu", name="feature", dtype=body)(x)
+    frames = observation_input(obs_shape)
+    x = cnn_features(frames, "small", body)
     logits = layers.Dense(n_actions, name="policy_logits", dtype="float32")(x)
     value = layers.Dense(1, name="value", dtype="float32")(x)
     return keras.Model(frames, [logits, value], name="actor_critic")
