@@ -47,7 +47,7 @@ def make_atari(env_id: str, render_mode: str | None, max_episode_steps: int | No
 
     register_atari()
     with filtered_stderr():  # the emulator's banner, on every env
-        env = gym.make(env_id, frameskip=1, **({"render_mode": render_mode} if render_mode else {}), **env_kwargs)
+        env = gym.make(env_id, **{"frameskip": 1, **({"render_mode": render_mode} if render_mode else {}), **env_kwargs})
     env = gym.wrappers.AtariPreprocessing(env, **PREPROCESSING)
     env = gym.wrappers.FrameStackObservation(env, STACK)
     space = env.observation_space

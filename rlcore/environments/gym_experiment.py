@@ -153,9 +153,9 @@ def _gym_make(env_id: str, render_mode: str | None, max_episode_steps: int | Non
     if draws_with_opengl(gym.spec(env_id).entry_point):
         require("mujoco", f"{env_id} (MuJoCo)")
         route_mujoco_warnings()
+    arguments: dict = {**({"render_mode": render_mode} if render_mode else {}), **env_kwargs}
     with filtered_stderr():
-        return gym.make(env_id, max_episode_steps=max_episode_steps,
-                    **({"render_mode": render_mode} if render_mode else {}), **env_kwargs)
+        return gym.make(env_id, max_episode_steps=max_episode_steps, **arguments)
 
 
 def _declared_modes(env_id: str) -> list[str] | None:
