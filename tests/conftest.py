@@ -56,7 +56,8 @@ def toy_experiments(monkeypatch):
 # few-but-long files such as the end-to-end runs for last, one worker busy while the other idles).
 # Ranked by their time on a worker of `make test` (2026-11-27, after the suite was made to do less); only
 # the order changes, every file still runs.
-LONGEST_FIRST = ("test_sweep.py", "test_end_to_end.py", "test_training.py", "test_atari_mujoco.py", "test_stop_signals.py",
+LONGEST_FIRST = ("test_sweep.py", "test_end_to_end.py", "test_training.py", "test_atari_mujoco.py", "test_docs_examples.py",
+                 "test_stop_signals.py",
                  "test_shipped_models.py", "test_sweep_without_ray.py", "test_resume.py", "test_gym_envs.py",
                  "test_cli.py", "test_obs_norm.py", "test_sac.py", "test_bad_values.py", "test_export.py",
                  "test_ppo.py", "test_api.py", "test_partial_episodes.py", "test_restarts.py")
