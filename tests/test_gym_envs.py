@@ -170,18 +170,22 @@ def test_mismatch_is_one_line_and_exit_2(tmp_path, capsys, env_id, algo, message
     assert not (tmp_path / "run").exists()
 
 
-def test_image_env_with_dqn_names_what_dqn_needs(tmp_path):
-    """An image env with discrete actions: PPO's CNN fits, the DQN family does not."""
+def test_an_image_env_fits_every_discrete_family_and_dqn_trains_on_its_frames(tmp_path):
+    """An image env with discrete actions: the DQN family, A2C and PPO fit it (their CNN bodies); SAC,
+    which needs continuous actions, says so. A short DQN run keeps its frames uint8 in the replay memory."""
     from rlcore.environments.registry import get_experiment
 
     gym.register("ImageSign-v0", entry_point="tests.toy:ImageSignEnv")
     try:
         exp = get_experiment("ImageSign-v0")
-        assert list(exp.algos) == ["ppo"]
-        with pytest.raises(UserError, match=r"^dqn does not fit ImageSign-v0: it needs vector observations "
-                                            r"\(a 1-D Box\), and the env's are Box\(0, 255, \(8, 8, 2\), uint8\); "
-                                            r"algorithms that fit it: ppo$"):
-            exp.algo("dqn")
+        assert list(exp.algos) == ["dqn", "ddqn", "dueling_dqn", "dueling_ddqn", "a2c", "ppo"]
+        with pytest.raises(UserError, match=r"^sac does not fit ImageSign-v0: it needs continuous actions"):
+            exp.algo("sac")
+        run = api.train("ImageSign-v0", "dueling_ddqn", run_dir=tmp_path / "run", episodes=3, final_eval_episodes=2,
+                        learning_starts=8, batch_size=8, progress=False)
+        with np.load(tmp_path / "run" / "replay.npz") as replay:
+            assert replay["obs"].dtype == np.uint8 and replay["obs"].shape[1:] == (8, 8, 2)
+        assert np.isfinite(run.evaluation["mean"])
     finally:
         del gym.registry["ImageSign-v0"]
 
