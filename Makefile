@@ -93,8 +93,10 @@ docs-check: $(ALL)
 gifs: $(ALL)
 	$(PY) -m tools.gifs
 
-# Commit the checkpoints and CSV tables of the runs under long_runs/ (before every stop of a session).
+# Commit the checkpoints and CSV tables of the runs under long_runs/ (before every stop of a session), with
+# the figure of their flag share against env steps.
 save-long-runs:
+	$(PY) long_runs/queue.py --plot long_runs/mario_ppo/flag_share.png
 	git add -A long_runs
 	git diff --cached --quiet -- long_runs || git commit -q -m "long_runs: checkpoints and CSV tables" -- long_runs
 

@@ -6,6 +6,7 @@ Each level's run is then evaluated on 30 further unseen seeds.
 
     .venv/bin/python long_runs/queue.py --dry-run     # the next command, from the folders' state
     .venv/bin/python long_runs/queue.py --status      # where each run stands, a line each
+    .venv/bin/python long_runs/queue.py --plot long_runs/mario_ppo/flag_share.png   # the runs' flag share
     setsid nohup .venv/bin/python long_runs/queue.py > /tmp/queue.log 2>&1 &
 
 Each step is read from the folders when the step before it ends, so the queue can be stopped and started
@@ -91,22 +92,82 @@ def run_status(name: str, folders: Path = HERE) -> str:
     return f"{name}: queued"
 
 
-def _progress(metrics: Path) -> str:
-    """Env steps and episodes so far, and the flag in the last 100 episodes from the level's start."""
+def _rows(metrics: Path) -> list[dict] | None:
+    """The episode rows of a run's metrics.csv (damaged rows left out, as a resume reads them); None
+    when there is no readable table."""
     from rlcore.errors import UserError
-    from rlcore.files.csv_tables import read_table  # a resume's reader: damaged rows left out
+    from rlcore.files.csv_tables import read_table
 
     try:
         table, _ = read_table(metrics)
     except (OSError, UserError):
+        return None
+    return [dict(zip(table[0], row)) for row in table[1:]]
+
+
+def _from_start(row: dict) -> bool:
+    return row.get("restarted") in (None, "", "0", "0.0")  # a restarted episode began mid-level
+
+
+def _flag(row: dict) -> bool:
+    return row.get("success") in ("1", "1.0", "True")
+
+
+def _progress(metrics: Path) -> str:
+    """Env steps and episodes so far, and the flag in the last 100 episodes from the level's start."""
+    rows = _rows(metrics)
+    if rows is None:
         return "no readable metrics.csv"
-    if len(table) < 2:
+    if not rows:
         return "no episode yet"
-    rows = [dict(zip(table[0], row)) for row in table[1:]]
-    counted = [r for r in rows if r.get("restarted") in (None, "", "0", "0.0")][-100:]
-    flags = sum(r.get("success") in ("1", "1.0", "True") for r in counted)
+    counted = [r for r in rows if _from_start(r)][-100:]
     return (f"{int(float(rows[-1]['env_steps'])):,} env steps, {len(rows):,} episodes, "
-            f"flag in {flags} of the last {len(counted)} from the start")
+            f"flag in {sum(map(_flag, counted))} of the last {len(counted)} from the start")
+
+
+def flag_curve(metrics: Path) -> tuple[list[int], list[float]]:
+    """(env steps, flag share of the last 100 episodes from the level's start), one point per such episode
+    from the 100th on."""
+    steps, shares, window = [], [], []
+    for row in _rows(metrics) or []:
+        if _from_start(row):
+            window = [*window[-99:], _flag(row)]
+            if len(window) == 100:
+                steps.append(int(float(row["env_steps"])))
+                shares.append(sum(window) / 100)
+    return steps, shares
+
+
+DEFAULT_1_1 = "results/sweeps/mario_ppo__1-1"  # 1-1's recipe before this queue, 3 seeds: what the flag preset is measured against
+
+
+def plot(path: Path, folders: Path = HERE) -> None:
+    """The flag share against env steps of every run that has one, beside 1-1's default preset (3 seeds), with
+    the bar (27 of 30) and the stop share of the recipe (0.95)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    for i, metrics in enumerate(sorted(folders.glob(f"{DEFAULT_1_1}/seed=*/metrics.csv"))):
+        steps, shares = flag_curve(metrics)
+        ax.plot([s / 1e6 for s in steps], shares, color="silver", linewidth=0.8,
+                label="1-1, default preset (3 seeds)" if i == 0 else None)
+    for name, _, extra in RUNS:
+        steps, shares = flag_curve(folders / run_dir(name) / "metrics.csv")
+        if steps:
+            ax.plot([s / 1e6 for s in steps], shares, label=name, linestyle="--" if extra else "-", linewidth=1.2)
+    ax.axhline(0.9, color="gray", linewidth=0.8, linestyle=":", label="bar: 27 of 30")
+    ax.axhline(0.95, color="black", linewidth=0.8, linestyle=":", label="stop share 0.95")
+    ax.set(xlabel="env steps (millions)", ylabel="flag share, last 100 episodes from the start", ylim=(0, 1),
+           title="Mario, one command per level (flag preset): training")
+    ax.legend(loc="lower right", fontsize=8, ncol=2)
+    fig.tight_layout()
+    tmp = path.with_name(f".{path.name}.tmp.png")
+    fig.savefig(tmp, dpi=100)
+    plt.close(fig)
+    os.replace(tmp, path)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -114,7 +175,12 @@ def main(argv: list[str] | None = None) -> int:
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--dry-run", action="store_true", help="print the next command and exit")
     parser.add_argument("--status", action="store_true", help="print where each run stands and exit")
+    parser.add_argument("--plot", metavar="PNG", help="write the flag share against env steps of every run and exit")
     args = parser.parse_args(argv)
+    if args.plot:
+        plot(Path(args.plot))
+        print(f"plot: {args.plot}")
+        return 0
     if args.status:
         print("\n".join(run_status(name) for name, _, _ in RUNS))
         return 0

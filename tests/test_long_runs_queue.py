@@ -104,3 +104,21 @@ def test_status_says_where_each_run_stands(tmp_path):
             evaluation={"success_share": 0.9, "episodes": 30}, further_evaluations=[{"success_share": 1.0, "episodes": 30}])
     assert queue.run_status("1-1", tmp_path) == ("1-1: finished at 5,000 env steps (stop_success_share 0.95); flag on "
                                                  "unseen seeds: 27 of 30, 30 of 30")
+
+
+def test_the_flag_curve_counts_the_last_100_episodes_from_the_levels_start(tmp_path):
+    """Restarted episodes (begun mid-level) stay out of the share, as out of the recipe's stop rule; the
+    curve starts at the 100th episode from the start. The figure is written whole, beside no other file."""
+    metrics = tmp_path / queue.run_dir("1-1") / "metrics.csv"
+    metrics.parent.mkdir(parents=True)
+    rows = ["episode,success,env_steps,restarted"]
+    for i in range(1, 161):  # every 4th episode restarted; from the start, every other one reaches the flag
+        rows.append(f"{i},{int(i % 2 == 0)},{i * 100},{int(i % 4 == 0)}")
+    metrics.write_text("\n".join(rows) + "\n")
+    steps, shares = queue.flag_curve(metrics)
+    from_start = [i for i in range(1, 161) if i % 4]
+    assert len(steps) == len(from_start) - 99 and steps[0] == from_start[99] * 100
+    window = from_start[-100:]
+    assert shares[-1] == sum(i % 2 == 0 for i in window) / 100
+    queue.plot(tmp_path / "flag_share.png", folders=tmp_path)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["flag_share.png", "long_runs"]

@@ -50,6 +50,23 @@ FILES = {"savedmodel": "saved_model", "tflite": "model.tflite", "onnx": "model.o
 PARITY_OBSERVATIONS = 256  # observations the parity check feeds both models (default)
 
 
+def _observations(exp, policy, observations: int | np.ndarray, episodes: int) -> tuple[np.ndarray, object]:
+    """The parity check's observations and the seeds they came from (None for an array given)."""
+    if isinstance(observations, np.ndarray):
+        return observations.astype(policy.dtype, copy=False), None
+    return collect_observations(exp, policy, int(observations), episodes)
+
+
+def _parity(acts, model, obs: np.ndarray, reference, exported, as_trained: str | None) -> dict:
+    """The export against the Keras network it came from; a bfloat16 model, exported in float32, also
+    against itself as trained (how far the export moved it)."""
+    parity = compare(acts.discrete, reference, exported)
+    if as_trained is not None:
+        parity["vs_as_trained_" + as_trained] = compare(acts.discrete, _outputs(acts.acting_network(model), obs),
+                                                        exported, figures_only=True)
+    return parity
+
+
 def export_model(model_dir: str | os.PathLike, fmt: str, out_dir: str | os.PathLike, *,
                  observations: int | np.ndarray = PARITY_OBSERVATIONS, episodes: int = 3,
                  source: str | None = None, experiment: str | None = None, algo: str | None = None) -> dict:
@@ -73,10 +90,7 @@ def export_model(model_dir: str | os.PathLike, fmt: str, out_dir: str | os.PathL
     kind = exp.algo(meta["algo"]).kind
     acts = family(kind)
     acting, as_trained = acting_network(policy.model, acts.acting_network)
-    if isinstance(observations, np.ndarray):
-        obs, seeds = observations.astype(policy.dtype, copy=False), None
-    else:
-        obs, seeds = collect_observations(exp, policy, int(observations), episodes)
+    obs, seeds = _observations(exp, policy, observations, episodes)
     reference = _outputs(acting, obs)
 
     with written(out_dir):
@@ -87,10 +101,7 @@ def export_model(model_dir: str | os.PathLike, fmt: str, out_dir: str | os.PathL
         with written(out_dir):  # TensorFlow's, LiteRT's and tf2onnx's writers on a full or read-only disk
             converter = WRITERS[fmt](acting, path)
         exported = runtime.run(path, obs)
-        parity = compare(acts.discrete, reference, exported)
-        if as_trained is not None:  # a bfloat16 model is exported in float32: how far that moved it
-            parity["vs_as_trained_" + as_trained] = compare(acts.discrete, _outputs(acts.acting_network(policy.model), obs),
-                                                            exported, figures_only=True)
+        parity = _parity(acts, policy.model, obs, reference, exported, as_trained)
         record = _record(fmt, source or str(model_dir), exp, meta["algo"], acts, acting, obs, reference,
                          as_trained, runtime, converter, parity, seeds)
         if not parity["passed"]:

@@ -96,41 +96,47 @@ def run_evaluation(exp, policy, episodes: int, seed_base: int | None, meta: dict
     """
     seed_base = exp.eval_seed_base if seed_base is None else seed_base
     seeds = f"{seed_base}..{seed_base + episodes - 1}"
-    goal = exp.goal
-    if goal:
-        success_key, progress_key = goal.success_key, goal.progress_key
-        from rlcore.training.evaluation import count_causes, evaluate_success, summarize_success
+    evaluate = _evaluate_success if exp.goal else _evaluate_returns
+    found, line = evaluate(exp, policy, episodes, seed_base, meta)
+    summary = {key: value for key, value in found.items() if key not in ("policy", "per_episode")}
+    summary.update(seeds=seeds, policy=found["policy"], per_episode=found["per_episode"])  # meta.json's order
+    return summary, line + _bar_words(exp, meta, summary, seed_base) + (
+        f" (seeds {seeds}, actions sampled from pi)" if exp.goal else "")
 
-        records = evaluate_success(policy.make_env, policy.sample, episodes, seed_base, success_key,
-                                   progress_key, info_keys=exp.info_keys)
-        summary = {**summarize_success(records, progress_key), "seeds": seeds,
-                   "policy": "sampled from pi, numpy RNG seeded per episode",
-                   "per_episode": records}
-        word = success_word(exp.name, model_name(exp, meta), other=success_key)
-        line = (f"{word} in {sum(r['success'] for r in records)} of {len(records)} episodes "
-                f"({summary['success_share']:.0%}); mean return {summary['mean_return']:.1f}")
-        if progress_key:
-            line += (f"; {progress_key} mean {summary[f'mean_{progress_key}']:.0f}, "
-                     f"max {summary[f'max_{progress_key}']:.0f}")
-        if goal.cause_key and (causes := count_causes(records, goal.cause_key, goal.cause_name)):
-            summary["causes"] = dict(causes)
-            line += f"; {goal.cause_key}: " + ", ".join(f"{name} {count}" for name, count in causes)
-        return summary, line + _bar_words(exp, meta, summary, seed_base) + f" (seeds {seeds}, actions sampled from pi)"
+
+def _evaluate_success(exp, policy, episodes: int, seed_base: int, meta: dict | None) -> tuple[dict, str]:
+    """The share of episodes reaching the goal, actions drawn from pi."""
+    from rlcore.training.evaluation import count_causes, evaluate_success, summarize_success
+
+    goal = exp.goal
+    success_key, progress_key = goal.success_key, goal.progress_key
+    records = evaluate_success(policy.make_env, policy.sample, episodes, seed_base, success_key,
+                               progress_key, info_keys=exp.info_keys)
+    summary = {**summarize_success(records, progress_key), "policy": "sampled from pi, numpy RNG seeded per episode",
+               "per_episode": records}
+    word = success_word(exp.name, model_name(exp, meta), other=success_key)
+    line = (f"{word} in {sum(r['success'] for r in records)} of {len(records)} episodes "
+            f"({summary['success_share']:.0%}); mean return {summary['mean_return']:.1f}")
+    if progress_key:
+        line += f"; {progress_key} mean {summary[f'mean_{progress_key}']:.0f}, max {summary[f'max_{progress_key}']:.0f}"
+    if goal.cause_key and (causes := count_causes(records, goal.cause_key, goal.cause_name)):
+        summary["causes"] = dict(causes)
+        line += f"; {goal.cause_key}: " + ", ".join(f"{name} {count}" for name, count in causes)
+    return summary, line
+
+
+def _evaluate_returns(exp, policy, episodes: int, seed_base: int, meta: dict | None) -> tuple[dict, str]:
+    """The return of greedy play (SAC: its mean action), with the info keys the experiment reports."""
+    from rlcore.networks.acting import MeanActionPolicy
     from rlcore.training.evaluation import play_greedy
 
-    records = play_greedy(exp, policy, episodes, seed_base, make_env=policy.make_env,
-                          info_keys=exp.info_keys)
+    records = play_greedy(exp, policy, episodes, seed_base, make_env=policy.make_env, info_keys=exp.info_keys)
     returns = np.array([r["return"] for r in records])
     full = sum(r["time_limit"] for r in records)
-    summary = {"episodes": episodes, "mean": round(float(returns.mean()), 2),
-               "std": round(float(returns.std()), 2), "min": round(float(returns.min()), 2),
-               "max": round(float(returns.max()), 2),
-               "time_limit_share": round(full / episodes, 3), "seeds": seeds, "policy": "greedy",
-               "per_episode": records}
+    summary = {"episodes": episodes, "mean": round(float(returns.mean()), 2), "std": round(float(returns.std()), 2),
+               "min": round(float(returns.min()), 2), "max": round(float(returns.max()), 2),
+               "time_limit_share": round(full / episodes, 3), "policy": "greedy", "per_episode": records}
     digits = return_digits(summary["mean"])  # as score_words, the README and `list` write the recorded one
-    # SAC acts by its mean action, the others by their greedy action
-    from rlcore.networks.acting import MeanActionPolicy
-
     acting = "mean-action" if isinstance(policy, MeanActionPolicy) else "greedy"
     line = (f"{acting} return {score_words(summary, exp.name, '', '+-')} over {count(len(returns), 'episode')} "
             f"(min {returns.min():,.{digits}f}, max {returns.max():,.{digits}f}); {full}/{episodes} lasted to "
@@ -142,7 +148,7 @@ def run_evaluation(exp, policy, episodes: int, seed_base: int | None, meta: dict
             line += f"; {key} at the end: mean {np.mean(values):.2f}, max {np.max(values):.2f}"
     if exp.solved_score is not None:
         line += f"; the task's solved score {exp.solved_score:g}: {'met' if returns.mean() >= exp.solved_score else 'not met'}"
-    return summary, line + _bar_words(exp, meta, summary, seed_base)
+    return summary, line
 
 
 def _bar_words(exp, meta: dict | None, summary: dict, seed_base: int) -> str:

@@ -20,7 +20,6 @@ def sweep_status(folder: str | Path) -> list[str]:
     started), then the hours of training left (:func:`time_left`). A trial whose tables are damaged
     gets its line without a pace, and the sweep no hours left."""
     from rlcore.sweeps.sweep import Sweep, trial_name
-    from rlcore.sweeps.trial import final_metrics
 
     sweep = Sweep.load(Path(folder))
     trials = [trial_name(t) for t in sweep.trials()]
@@ -36,39 +35,55 @@ def sweep_status(folder: str | Path) -> list[str]:
             left.append(NOT_STARTED)
             continue
         budgets.add((record.get("config") or {}).get("max_env_steps"))
-        try:
-            critic = critic_trace(trial)  # a Q-learner's critic now, beside the returns it was paid
-        except (OSError, ValueError, KeyError):  # a damaged table: the line without it
-            critic = None
-        critic_text = f"; critic: mean Q {critic_cell(critic)}" if critic else ""
         if "returns" not in record:  # a model's meta.json: finished
             if record.get("wall_seconds") and math.isfinite(record["env_steps"] / record["wall_seconds"]):
                 rates.append(record["env_steps"] / record["wall_seconds"])
-            final = final_metrics(record)  # as the sweep reports it (Mario: flag share)
-            lines.append(f"  {name}: finished at {final['env_steps']:,} env steps"
-                         + (f", final score {final['final_score']:.2f} on unseen seeds"
-                            if not math.isnan(final["final_score"]) else  # NaN: not evaluated
-                            "; not evaluated on unseen seeds" + ("" if sweep.final_eval_episodes == 0 else
-                                                                 " yet (the sweep's --resume evaluates it)"))
-                         + critic_text)
+            lines.append(f"  {name}: " + finished_text(record, sweep.final_eval_episodes) + critic_text(trial))
             continue
-        try:
-            measured = pace(trial / "metrics.csv", record)
-            text = pace_text(trial / "metrics.csv", record, measured)
-            last = evaluation_lines(trial / "evals.csv", last=1)
-        except UserError:  # a damaged table: the trial's line without what it would have said
-            measured, text, last = None, None, []
-        lines.append(f"  {name}: checkpoint at {record['env_steps']:,} env steps, "
-                     f"{record.get('wall_seconds', 0) / 3600:.1f} h" + (f", {text}" if text else "")
-                     + (f"; last {last[0]}" if last else "") + critic_text)
-        trial_budget = (record.get("config") or {}).get("max_env_steps")
-        if measured and measured[1] is None and trial_budget and trial_budget < NO_BUDGET:
-            left.append(NotLearning(max(0, trial_budget - record["env_steps"])))  # no gradient step yet
-        else:
-            left.append(measured[1] if measured else None)
+        text, seconds_left = checkpoint_text(trial, record)
+        lines.append(f"  {name}: {text}{critic_text(trial)}")
+        left.append(seconds_left)
     budgets.discard(None)  # a record without its config says nothing of the budget
     budget = budgets.pop() if len(budgets) == 1 else None
     return lines + time_left(left, rates, budget if budget and budget < NO_BUDGET else None, sweep.max_concurrent)
+
+
+def critic_text(trial: Path) -> str:
+    """``; critic: mean Q ...``: a Q-learner's critic now, beside the returns it was paid; nothing for a
+    damaged table or another learner."""
+    try:
+        critic = critic_trace(trial)
+    except (OSError, ValueError, KeyError):
+        return ""
+    return f"; critic: mean Q {critic_cell(critic)}" if critic else ""
+
+
+def finished_text(record: dict, final_eval_episodes: int) -> str:
+    """A finished trial's env steps and final score as the sweep reports it (Mario: flag share)."""
+    from rlcore.sweeps.trial import final_metrics
+
+    final = final_metrics(record)
+    if not math.isnan(final["final_score"]):
+        return f"finished at {final['env_steps']:,} env steps, final score {final['final_score']:.2f} on unseen seeds"
+    return (f"finished at {final['env_steps']:,} env steps; not evaluated on unseen seeds"  # NaN: not evaluated
+            + ("" if final_eval_episodes == 0 else " yet (the sweep's --resume evaluates it)"))
+
+
+def checkpoint_text(trial: Path, record: dict) -> tuple[str, object]:
+    """A stopped or running trial's line (checkpoint, hours, pace, last periodic evaluation) and its
+    seconds left for :func:`time_left` (None when a damaged table cannot tell)."""
+    try:
+        measured = pace(trial / "metrics.csv", record)
+        text = pace_text(trial / "metrics.csv", record, measured)
+        last = evaluation_lines(trial / "evals.csv", last=1)
+    except UserError:  # a damaged table: the trial's line without what it would have said
+        measured, text, last = None, None, []
+    line = (f"checkpoint at {record['env_steps']:,} env steps, {record.get('wall_seconds', 0) / 3600:.1f} h"
+            + (f", {text}" if text else "") + (f"; last {last[0]}" if last else ""))
+    budget = (record.get("config") or {}).get("max_env_steps")
+    if measured and measured[1] is None and budget and budget < NO_BUDGET:
+        return line, NotLearning(max(0, budget - record["env_steps"]))  # no gradient step yet
+    return line, measured[1] if measured else None
 
 
 class NotLearning(float):

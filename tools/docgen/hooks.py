@@ -1,5 +1,5 @@
-"""MkDocs hook (mkdocs.yml ``hooks:``): serve the shipped models' plots and training logs and the kept
-sweeps' reports and curves from where they live, as if under docs/, without a second copy. The pages link
+"""MkDocs hook (mkdocs.yml ``hooks:``): serve the shipped models' plots and training logs, the kept
+sweeps' reports and curves and the long runs' figure from where they live, as if under docs/, without a second copy. The pages link
 to them by their true place (``../../saved_networks/...`` from ``docs/models/``), which works where the
 pages are read as files (GitHub, an editor); for the site, :func:`on_page_markdown` points each such
 link at the mounted copy."""
@@ -11,7 +11,7 @@ from mkdocs.structure.files import File, Files
 
 REPO = Path(__file__).resolve().parents[2]
 MOUNTED = {"saved_networks": ("*.png", "HOW_TRAINED.md", "TRY.md", "meta.json"),
-           "results/sweeps": ("*.png", "report.md", "sweep.json")}
+           "results/sweeps": ("*.png", "report.md", "sweep.json"), "long_runs/mario_ppo": ("flag_share.png",)}
 # a markdown link or image target: ](target) or ](target "title"); no spaces inside a target here
 LINK = re.compile(r"(\]\()([^)\s]+)((?:\s+\"[^\"]*\")?\))")
 
