@@ -4,6 +4,7 @@ import json
 
 import imageio.v3 as iio
 import numpy as np
+import pytest
 
 from rlcore import api
 from tests.test_cli import run as cli
@@ -67,3 +68,15 @@ def test_half_cheetah_sac_trains_renders_through_its_own_process_and_exports(tmp
                          "--out", str(tmp_path / "tflite"))
     assert code == 0 and "passed" in out, err
     assert not (tmp_path / "MUJOCO_LOG.TXT").exists()  # MuJoCo's warnings are routed, not logged in the folder
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["ALE/Pong-v5", "sac"], "sac does not fit ALE/Pong-v5: it needs continuous actions"),
+    (["ALE/Pong-v5", "dqn", "--env-kwargs", "frameskip=4"], "frameskip is the Atari preprocessing's"),
+    (["ALE/Pong-v5", "dqn", "--env-kwargs", "mode=99"], "--env-kwargs: ALE/Pong-v5 refused {'mode': 99}"),
+    (["ALE/NoSuchGame-v5", "dqn"], "the games ale-py registers"),
+])
+def test_what_atari_refuses_is_one_line_before_any_folder(tmp_path, capsys, argv, words):
+    code, out, err = cli(capsys, "train", *argv, "--steps", "10", "--run-dir", str(tmp_path / "run"), "--wandb", "off")
+    assert code == 2 and words in err and len(err.strip().splitlines()) == 1, err
+    assert not (tmp_path / "run").exists()

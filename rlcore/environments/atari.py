@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from rlcore.errors import UserError
 from rlcore.host.extras import require
 from rlcore.host.quiet import filtered_stderr
 
@@ -46,6 +47,9 @@ def make_atari(env_id: str, render_mode: str | None, max_episode_steps: int | No
     import gymnasium as gym
 
     register_atari()
+    if "frameskip" in env_kwargs:
+        raise UserError(f"--env-kwargs: frameskip is the Atari preprocessing's ({PREPROCESSING['frame_skip']} frames "
+                        "per step, max-pooled), not the env's; give the others")
     with filtered_stderr():  # the emulator's banner, on every env
         env = gym.make(env_id, **{"frameskip": 1, **({"render_mode": render_mode} if render_mode else {}), **env_kwargs})
     env = gym.wrappers.AtariPreprocessing(env, **PREPROCESSING)

@@ -76,8 +76,9 @@ def gym_spec(name: str) -> EnvSpec:
     try:
         return gym.spec(env_id)
     except gym.error.Error as exc:
-        hint = (" (import the module that calls gymnasium.register first, or give MODULE:ID)"
-                if module is None else f" ({module} did not register it)")
+        hint = (f" ({module} did not register it)" if module else " (the games ale-py registers: ALE/Pong-v5, "
+                "ALE/Breakout-v5, ...)" if atari.is_atari(env_id) else
+                " (import the module that calls gymnasium.register first, or give MODULE:ID)")
         raise UserError(f"{env_id} is not a registered Gymnasium id: {exc}{hint}") from None
 
 
@@ -235,7 +236,9 @@ def _build(name: str, env_kwargs: dict) -> Experiment:
         env = make_gym_env(name=name, env_kwargs=env_kwargs)
     except gym.error.DependencyNotInstalled as exc:
         raise UserError(_missing_dependency(spec, exc)) from None
-    except (TypeError, ValueError, AssertionError) as exc:  # a value the env's own checks refuse
+    except UserError:
+        raise
+    except Exception as exc:  # a value the env's own checks refuse, whatever it raises (ale-py: RuntimeError)
         if not env_kwargs:
             raise
         raise UserError(f"--env-kwargs: {spec.id} refused {env_kwargs}: {exc}") from None
