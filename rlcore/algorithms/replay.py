@@ -3,6 +3,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from rlcore.errors import UserError
+from rlcore.host.machine import available_memory
+
 
 class ReplayMemory:
     """Fixed-capacity FIFO of transitions (obs, action, reward, next_obs, terminated).
@@ -163,7 +166,8 @@ class FrameStackReplay:
 
 def replay_memory(capacity: int, env):
     """The memory for ``env``: :class:`FrameStackReplay` where a wrapper says it stacks frames on the
-    last axis (``stacked_frames``, the Atari preprocessing), else :class:`ReplayMemory` (``uint8`` images)."""
+    last axis (``stacked_frames``, the Atari preprocessing), else :class:`ReplayMemory` (``uint8`` images);
+    one line instead when it would not fit in the machine's free memory."""
     space = env.observation_space
     shape = tuple(space.shape)
     try:
@@ -171,5 +175,17 @@ def replay_memory(capacity: int, env):
     except AttributeError:
         stacked = None
     if stacked and len(shape) == 3 and shape[-1] == stacked:
+        check_fits(capacity, capacity * (int(np.prod(shape[:-1])) + 13))  # a frame, action, reward, ends
         return FrameStackReplay(capacity, shape)
-    return ReplayMemory(capacity, shape, np.uint8 if len(shape) == 3 and space.dtype == np.uint8 else np.float32)
+    dtype = np.dtype(np.uint8 if len(shape) == 3 and space.dtype == np.uint8 else np.float32)
+    check_fits(capacity, capacity * (2 * int(np.prod(shape)) * dtype.itemsize + 12))  # obs twice, action, reward, terminated
+    return ReplayMemory(capacity, shape, dtype)
+
+
+def check_fits(capacity: int, nbytes: int) -> None:
+    """A one-line error where a memory of ``nbytes`` exceeds what the machine has free: its arrays are only
+    touched as it fills, so one too large would end the run hours later, or not start at all."""
+    free = available_memory()
+    if free is not None and nbytes > free:
+        raise UserError(f"--buffer-size {capacity:,}: a replay memory of {nbytes / 1e9:.1f} GB, and this machine "
+                        f"has {free / 1e9:.1f} GB free; give a smaller --buffer-size")

@@ -87,3 +87,16 @@ def replays_exactly(recorded: dict | None, here: dict | None = None) -> bool:
         return False
     versions = here.get("versions", {})
     return all(versions.get(name) == value for name, value in recorded.get("versions", {}).items())
+
+
+def available_memory() -> int | None:
+    """Bytes of memory the system can give a process without swapping (Linux's MemAvailable); None where
+    it cannot be read."""
+    try:
+        with open("/proc/meminfo") as meminfo:
+            for line in meminfo:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        return None
+    return None

@@ -87,3 +87,34 @@ def test_100000_atari_transitions_stay_within_the_stated_size():
         obs = next_obs
     grown = process.memory_info().rss - before
     assert len(memory) == 100_000 - K and grown < memory.nbytes + 50e6, (grown, memory.nbytes)
+
+
+class _Env:
+    """What replay_memory reads of an env: its observation space and the frame-stack marker."""
+
+    def __init__(self, shape, dtype, stacked=None):
+        import gymnasium as gym
+
+        self.observation_space = gym.spaces.Box(0, 255, shape, dtype)
+        self.stacked = stacked
+
+    def get_wrapper_attr(self, name):
+        if self.stacked is None:
+            raise AttributeError(name)
+        return self.stacked
+
+
+@pytest.mark.parametrize("env, kind", [(_Env((84, 84, 4), np.uint8, stacked=4), FrameStackReplay),
+                                       (_Env((96, 96, 3), np.uint8), ReplayMemory),
+                                       (_Env((8,), np.float32), ReplayMemory)])
+def test_a_memory_is_checked_against_free_memory_by_its_true_size(env, kind, monkeypatch):
+    from rlcore.algorithms import replay
+    from rlcore.errors import UserError
+
+    memory = replay.replay_memory(1_000, env)
+    assert type(memory) is kind
+    monkeypatch.setattr(replay, "available_memory", lambda: memory.nbytes)
+    replay.replay_memory(1_000, env)  # exactly what it takes fits
+    monkeypatch.setattr(replay, "available_memory", lambda: memory.nbytes - 1)
+    with pytest.raises(UserError, match=r"^--buffer-size 1,000: a replay memory of .* GB free; give a smaller"):
+        replay.replay_memory(1_000, env)
