@@ -208,3 +208,24 @@ def test_a_user_env_run_is_named_as_trained_or_by_its_id():
     assert names_the_env("Chase-v0", "tests.user_env:Chase-v0") and names_the_env(None, "lunar_lander")
     assert not names_the_env("Chase-v1", "tests.user_env:Chase-v0") and not names_the_env("Chase-v0", "Chase-v1")
     assert not names_the_env("user_env:Chase-v0", "tests.user_env:Chase-v0")
+
+
+def test_an_env_without_a_time_limit_gets_one_so_no_episode_runs_forever(tmp_path):
+    """Chase never ends an episode itself; registered without max_episode_steps (as CliffWalking-v1 is), a
+    greedy policy would play one evaluation episode for good. Episodes end at the added limit instead,
+    recorded in meta.json; --max-episode-steps still sets another."""
+    from rlcore.environments.gym_experiment import ADDED_TIME_LIMIT
+
+    gym.register("Endless-v0", entry_point="tests.user_env:ChaseEnv")
+    try:
+        run = api.train("Endless-v0", "dqn", run_dir=tmp_path / "run", episodes=1, final_eval_episodes=1,
+                        progress=False)
+        assert run.meta["env"]["time_limit_added"] == ADDED_TIME_LIMIT
+        assert run.evaluation["time_limit_share"] == 1.0 and run.meta["env_steps"] == ADDED_TIME_LIMIT
+        short = api.train("Endless-v0", "dqn", run_dir=tmp_path / "short", episodes=1, final_eval_episodes=1,
+                          max_episode_steps=30, progress=False)
+        assert short.meta["env_steps"] == 30
+    finally:
+        del gym.registry["Endless-v0"]
+    api_page = (Path(__file__).resolve().parents[1] / "docs" / "api.md").read_text()
+    assert f"gets one of {ADDED_TIME_LIMIT:,} steps" in " ".join(api_page.split())  # the page says the limit

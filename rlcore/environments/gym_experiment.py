@@ -44,6 +44,10 @@ if TYPE_CHECKING:
     from gymnasium.envs.registration import EnvSpec
 
 NO_THRESHOLD_STOP = 1e9  # stop_score of an env without a reward threshold: run the whole budget
+# the time limit of an env that registers none (CliffWalking-v1, a user's env), unless --max-episode-steps
+# gives one: without it, an episode a policy never ends (walking into a wall) would stall a run or an
+# evaluation for good. 1,000: the longest limit Gymnasium's own envs register (LunarLander, MuJoCo's)
+ADDED_TIME_LIMIT = 1_000
 
 _GYM_ID = re.compile(r"^([\w.]+:)?([\w.-]+/)?[\w.-]+-v\d+$")
 
@@ -107,13 +111,14 @@ def register_from_record(record: dict) -> None:
 
 def make_gym_env(render_mode: str | None = None, max_episode_steps: int | None = None, *, name: str,
                  rescale_actions: bool = False, env_kwargs: dict | None = None,
-                 in_worker: bool = False) -> gymnasium.Env:
+                 in_worker: bool = False, added_time_limit: int | None = None) -> gymnasium.Env:
     """The env ``name`` (``module:id`` imports the module first) with its registered time limit unless
-    ``max_episode_steps`` is given, built with ``env_kwargs`` (``--env-kwargs``); SAC's envs get their Box
-    actions rescaled from [-1, 1]. A MuJoCo env asked for frames runs in a worker process
-    (:mod:`rlcore.environments.remote`)."""
+    ``max_episode_steps`` is given (``added_time_limit`` where it registers none), built with ``env_kwargs``
+    (``--env-kwargs``); SAC's envs get their Box actions rescaled from [-1, 1]. A MuJoCo env asked for frames
+    runs in a worker process (:mod:`rlcore.environments.remote`)."""
     import gymnasium as gym
 
+    max_episode_steps = max_episode_steps or added_time_limit
     module, env_id = split_module(name)
     if module is not None:
         importlib.import_module(module)  # a spawned pool worker registers the user's env here
@@ -257,11 +262,14 @@ def _build(name: str, env_kwargs: dict) -> Experiment:
         preset = default_preset(kind, switches, spec.reward_threshold)
         algos[algo] = AlgoSpec(algo, kind, description, {"default": preset})
     rescale = any(not family(algo.kind).discrete for algo in algos.values())
+    # ALE's games end themselves (108,000 frames at most)
+    added = ADDED_TIME_LIMIT if spec.max_episode_steps is None and not atari.is_atari(spec.id) else None
     entry_point = spec.entry_point if isinstance(spec.entry_point, str) else None
     return Experiment(
         name=name,
         description=f"Gymnasium {spec.id} (observations {obs_space}, actions {act_space})",
-        make_env=partial(make_gym_env, name=name, rescale_actions=rescale, env_kwargs=env_kwargs or None),
+        make_env=partial(make_gym_env, name=name, rescale_actions=rescale, env_kwargs=env_kwargs or None,
+                         added_time_limit=added),
         algos=algos,
         solved_score=None if spec.reward_threshold is None else float(spec.reward_threshold),
         plot_prefix=re.sub(r"[^\w.-]", "_", spec.id),
@@ -269,6 +277,7 @@ def _build(name: str, env_kwargs: dict) -> Experiment:
         unfit=unfit,
         env_record={"gymnasium_id": spec.id, "entry_point": entry_point,
                     "kwargs": _jsonable(spec.kwargs), "max_episode_steps": spec.max_episode_steps,
+                    **({"time_limit_added": added} if added else {}),
                     "reward_threshold": spec.reward_threshold, "actions_rescaled_to": [-1, 1] if rescale else None,
                     "observations_one_hot": one_hot_obs, **({"env_kwargs": env_kwargs} if env_kwargs else {}),
                     **({"atari_preprocessing": atari.record()} if atari.is_atari(spec.id) else {})},
