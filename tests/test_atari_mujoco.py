@@ -9,6 +9,9 @@ import pytest
 from rlcore import api
 from tests.test_cli import run as cli
 
+pytest.importorskip("ale_py", reason="the atari extra")
+pytest.importorskip("mujoco", reason="the mujoco extra")
+
 QUIET = ["--wandb", "off", "--no-progress", "--final-eval-episodes", "1"]
 PONG_SMALL = ["--max-episode-steps", "40", "--batch-size", "8", "--learning-starts", "32", "--buffer-size", "300"]
 
@@ -40,6 +43,19 @@ def test_pong_dqn_learns_from_stacked_frames_and_every_command_takes_it(tmp_path
     assert code == 0 and "passed" in out, err
     record = json.loads((tmp_path / "onnx" / "export.json").read_text())
     assert record["network"]["input"]["shape"] == [None, 84, 84, 4] and record["network"]["input"]["dtype"] == "uint8"
+
+
+def test_pong_dqn_learns_once_its_frame_memory_is_full_even_when_learning_starts_asks_for_all_of_it(tmp_path, capsys):
+    """A frame memory's episode starts take slots, so it never holds --buffer-size transitions; the run still
+    learns once the memory is full (it trained a random policy to the end before)."""
+    run_dir = tmp_path / "full"
+    code, out, err = cli(capsys, "train", "ALE/Pong-v5", "dqn", "--episodes", "2", "--max-episode-steps", "40",
+                         "--batch-size", "8", "--buffer-size", "64", "--learning-starts", "64", *QUIET,
+                         "--run-dir", str(run_dir))
+    assert code == 0, err
+    last = (run_dir / "model" / "metrics.csv").read_text().splitlines()
+    header, row = last[0].split(","), last[-1].split(",")
+    assert int(float(row[header.index("grad_steps")])) > 0
 
 
 def test_pong_a2c_trains_on_frames_from_eight_envs(tmp_path, capsys):

@@ -66,8 +66,9 @@ def run_episodes(session: TrainingSession, env, memory: ReplayMemory, rng: np.ra
                 episode_return += reward
                 episode_steps += 1
                 obs = next_obs
-                # len(memory): after a resume without its replay file, the memory refills first
-                if session.env_steps % learner.update_period == 0 and len(memory) >= ready:
+                # len(memory): after a resume without its replay file, the memory refills first (a full
+                # frame memory holds fewer transitions than slots, and learns then too)
+                if session.env_steps % learner.update_period == 0 and (len(memory) >= ready or memory.full):
                     batches = memory.sample_stacked(cfg.updates_per_call, cfg.batch_size, rng)
                     with reported_divergence(session, learner.name, learner.divergence_hint):
                         losses.append(learner.learn(batches))

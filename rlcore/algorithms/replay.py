@@ -65,6 +65,10 @@ class ReplayMemory:
         self.position = int(state["position"]) % self.capacity
 
     @property
+    def full(self) -> bool:
+        return self.size == self.capacity
+
+    @property
     def nbytes(self) -> int:
         """What its arrays take, allocated in full."""
         return sum(getattr(self, name).nbytes for name in self.FIELDS)
@@ -111,18 +115,21 @@ class FrameStackReplay:
         self._write(next_obs[..., -1], True, action, reward, terminated)
         self._last_next = np.array(next_obs)
 
-    def _drawable(self) -> np.ndarray:
-        """Written counts (absolute slot numbers) of the transitions whose frames are all still kept."""
-        first = max(0, self.written - self.capacity + self.k)
-        slots = np.arange(first, self.written)
-        return slots[self.ends_transition[slots % self.capacity]]
+    def _first_drawable(self) -> int:
+        """The oldest slot (absolute) that can end a drawable transition: all k frames before it are kept."""
+        return max(0, self.written - self.capacity + self.k)
 
     def __len__(self) -> int:
         count = int(self.ends_transition.sum())
         if self.written > self.capacity:  # the transitions among the k oldest slots have lost frames
-            oldest = np.arange(self.written - self.capacity, self.written - self.capacity + self.k) % self.capacity
+            oldest = np.arange(self.written - self.capacity, self._first_drawable()) % self.capacity
             count -= int(self.ends_transition[oldest].sum())
         return count
+
+    @property
+    def full(self) -> bool:
+        """Every slot written: it holds what it can (fewer transitions than slots, k frames per episode start)."""
+        return self.written >= self.capacity
 
     def _stacks(self, ends: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(obs, next_obs) of the transitions ending at absolute slots ``ends``, H x W x k each."""
@@ -131,9 +138,13 @@ class FrameStackReplay:
         return frames[..., :-1], frames[..., 1:]
 
     def sample(self, batch_size: int, rng: np.random.Generator) -> tuple[np.ndarray, ...]:
-        """A uniform minibatch (with replacement) in :attr:`FIELDS` order."""
-        drawable = self._drawable()
-        ends = drawable[rng.integers(0, len(drawable), size=batch_size)]
+        """A uniform minibatch (with replacement) in :attr:`FIELDS` order: slots drawn among the kept ones,
+        those that end no transition (an episode's starting frames, a few in a hundred) drawn again."""
+        first, ends = self._first_drawable(), np.empty(0, np.int64)
+        while len(ends) < batch_size:
+            drawn = rng.integers(first, self.written, size=batch_size - len(ends) + 8)
+            ends = np.concatenate([ends, drawn[self.ends_transition[drawn % self.capacity]]])
+        ends = ends[:batch_size]
         obs, next_obs = self._stacks(ends)
         i = ends % self.capacity
         return obs, self.action[i], self.reward[i], next_obs, self.terminated[i]
@@ -145,22 +156,22 @@ class FrameStackReplay:
     def nbytes(self) -> int:
         return sum(a.nbytes for a in (self.frames, self.action, self.reward, self.terminated, self.ends_transition))
 
+    ARRAYS = ("frames", "action", "reward", "terminated", "ends_transition")
+
     def state_dict(self) -> dict[str, np.ndarray]:
-        """The kept slots, oldest first, and the count written."""
-        slots = np.arange(max(0, self.written - self.capacity), self.written) % self.capacity
-        return {"frames": self.frames[slots], "action": self.action[slots], "reward": self.reward[slots],
-                "terminated": self.terminated[slots], "ends_transition": self.ends_transition[slots],
-                "written": np.array(self.written)}
+        """The slots written, in ring order (views: a checkpoint of 0.7 GB of frames makes no second copy),
+        and the count written."""
+        used = min(self.written, self.capacity)
+        return {**{name: getattr(self, name)[:used] for name in self.ARRAYS}, "written": np.array(self.written)}
 
     def load_state_dict(self, state: dict[str, np.ndarray]) -> None:
         if "frames" not in state:
             raise ValueError("the replay file holds full observations, not frames")
-        written, kept = int(state["written"]), len(state["frames"])
-        if kept > self.capacity:
-            raise ValueError(f"checkpoint holds {kept} frames, memory capacity is {self.capacity}")
-        slots = np.arange(written - kept, written) % self.capacity
-        for name in ("frames", "action", "reward", "terminated", "ends_transition"):
-            getattr(self, name)[slots] = state[name]
+        written, used = int(state["written"]), len(state["frames"])
+        if used > self.capacity or (written > used and used != self.capacity):
+            raise ValueError(f"checkpoint holds a ring of {used} frames, memory capacity is {self.capacity}")
+        for name in self.ARRAYS:
+            getattr(self, name)[:used] = state[name]
         self.written, self._last_next = written, None
 
 

@@ -246,7 +246,8 @@ def _build(name: str, env_kwargs: dict) -> Experiment:
     except Exception as exc:  # a value the env's own checks refuse, whatever it raises (ale-py: RuntimeError)
         if not env_kwargs:
             raise
-        raise UserError(f"--env-kwargs: {spec.id} refused {env_kwargs}: {exc}") from None
+        said = exc if isinstance(exc, (TypeError, ValueError, AssertionError)) else f"{type(exc).__name__}: {exc}"
+        raise UserError(f"--env-kwargs: {spec.id} refused {env_kwargs}: {said}") from None
     try:
         obs_space, act_space = env.observation_space, env.action_space
         one_hot_obs = type(env.unwrapped.observation_space).__name__ == "Discrete"  # given one-hot

@@ -9,6 +9,7 @@ imports TensorFlow, over a Pipe, and the policy acts in the parent as always. Te
 from __future__ import annotations
 
 import multiprocessing
+import weakref
 from typing import Callable
 
 import gymnasium as gym
@@ -24,10 +25,18 @@ def draws_with_opengl(entry_point: object) -> bool:
 
 
 def _serve(conn, make_env: Callable[[], gym.Env]) -> None:
-    env = make_env()
-    conn.send((env.observation_space, env.action_space, env.metadata))
+    try:
+        env = make_env()
+    except Exception as exc:  # said by the parent, as one line
+        conn.send(("error", f"{type(exc).__name__}: {exc}"))
+        return
+    conn.send(("ok", (env.observation_space, env.action_space, env.metadata)))
     while True:
-        name, kwargs = conn.recv()
+        try:
+            name, kwargs = conn.recv()
+        except (EOFError, OSError):  # the parent is gone
+            env.close()
+            return
         if name == "close":
             env.close()
             conn.send(("ok", None))
@@ -36,6 +45,16 @@ def _serve(conn, make_env: Callable[[], gym.Env]) -> None:
             conn.send(("ok", getattr(env, name)(**kwargs)))
         except Exception as exc:  # sent back whole: the parent raises it as one line
             conn.send(("error", f"{type(exc).__name__}: {exc}"))
+
+
+def _end(conn, process) -> None:
+    """The worker's end however the parent ends: it ignores the stop signals (the parent handles them), so
+    at exit multiprocessing's SIGTERM would leave it, and the join, waiting for good."""
+    conn.close()
+    process.join(timeout=5)
+    if process.is_alive():
+        process.kill()
+        process.join(timeout=5)
 
 
 class RemoteEnv(gym.Env):
@@ -47,6 +66,7 @@ class RemoteEnv(gym.Env):
         self._process = context.Process(target=_serve, args=(child, IgnoringStopSignals(make_env)), daemon=True)
         self._process.start()
         child.close()
+        self._ended = weakref.finalize(self, _end, self._conn, self._process)
         self.name = name
         self.observation_space, self.action_space, self.metadata = self._receive("start")
 
@@ -56,10 +76,12 @@ class RemoteEnv(gym.Env):
         except EOFError:
             raise UserError(f"{self.name}: the process drawing its frames ended at {what} "
                             f"(exit code {self._process.exitcode})") from None
-        if isinstance(reply, tuple) and reply[:1] == ("error",):
-            raise UserError(f"{self.name} could not {what}: {reply[1]} (MuJoCo draws through OpenGL: "
-                            "EGL, or MUJOCO_GL=osmesa where EGL is missing)")
-        return reply[1] if isinstance(reply, tuple) and reply[:1] == ("ok",) else reply
+        status, value = reply
+        if status == "error":
+            hint = (" (MuJoCo draws through OpenGL: EGL, or MUJOCO_GL=osmesa where EGL is missing)"
+                    if what == "render" else "")
+            raise UserError(f"{self.name} could not {what}: {value}{hint}")
+        return value
 
     def _call(self, name: str, **kwargs):
         self._conn.send((name, kwargs))
@@ -80,6 +102,4 @@ class RemoteEnv(gym.Env):
                 self._call("close")
             except (UserError, BrokenPipeError, OSError):
                 pass
-        self._process.join(timeout=10)
-        if self._process.is_alive():
-            self._process.kill()
+        self._ended()

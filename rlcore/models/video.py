@@ -162,7 +162,7 @@ def record_video(experiment, policy, path: str | Path, fps: int = 30, episodes: 
                     successes.append(bool(info.get(success_key, False)))
         finally:
             writer.close()
-    env.close()
+            env.close()  # also on an error or Ctrl-C: an env in a worker process (MuJoCo's) ends with it
     result = {"path": str(path), "frames": writer.frames, "returns": returns, "lengths": lengths,
               "fps": fps}
     if gif:

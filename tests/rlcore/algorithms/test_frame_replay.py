@@ -63,8 +63,23 @@ def test_a_checkpoint_round_trip_gives_back_the_same_transitions():
     assert assert_same_as_given(again, full) == assert_same_as_given(frames, full)
     with pytest.raises(ValueError, match="full observations"):
         again.load_state_dict(full.state_dict())
+    with pytest.raises(ValueError, match="ring of 40 frames, memory capacity is 60"):  # a wrapped ring: its own size
+        FrameStackReplay(60, (SIDE, SIDE, K)).load_state_dict(frames.state_dict())
 
 
+def test_an_unwrapped_memory_loads_into_a_larger_one_whole():
+    frames, full = fill(40, [10, 12])
+    larger = FrameStackReplay(100, (SIDE, SIDE, K))
+    larger.load_state_dict(frames.state_dict())
+    assert len(larger) == len(frames) == 22 and assert_same_as_given(larger, full) == set(range(22))
+
+
+def test_a_full_memory_says_so_though_it_holds_fewer_transitions_than_slots():
+    """Each episode's k starting frames take slots, so a frame memory never holds as many transitions as
+    slots: the off-policy loop learns once it is full, whatever learning_starts asked (up to buffer_size)."""
+    frames, _ = fill(20, [5] * 6)
+    assert frames.full and len(frames) < 20
+    assert not fill(20, [5])[0].full
 def test_stacked_minibatches_keep_their_shapes():
     frames, _ = fill(200, [50, 50])
     obs, action, reward, next_obs, terminated = frames.sample_stacked(3, 8, np.random.default_rng(0))

@@ -41,3 +41,9 @@ def test_dqn_and_a2c_take_a_gradient_step_on_frames():
     cfg = A2CConfig(n_steps=2, num_envs=2)
     a2c = A2CAgent((36, 36, 2), 3, cfg)
     assert a2c.act(frames[:2], rng).shape == (2,)
+    before = [w.copy() for w in a2c.actor.model.get_weights()]
+    rollout = frames.reshape(2, 2, 36, 36, 2)
+    losses = a2c.update(rollout, np.zeros((2, 2), np.int32), np.ones((2, 2), np.float32), rollout,
+                        np.zeros((2, 2), np.float32), np.zeros((2, 2), np.float32))
+    assert all(np.isfinite(v) for v in losses.values())
+    assert any(not np.array_equal(b, a) for b, a in zip(before, a2c.actor.model.get_weights()))
