@@ -13,6 +13,7 @@ and ``sweep`` / ``report`` (``tests/test_sweep.py``).
 """
 import re
 import shlex
+import sys
 from pathlib import Path
 
 import pytest
@@ -63,17 +64,24 @@ def small_budgets(monkeypatch):
 
 @pytest.fixture
 def users_folder(tmp_path, monkeypatch):
-    """A fresh working folder holding the user's ``my_envs`` module of the README; Gymnasium's registry as
-    it was afterwards (the README registers ``Chase-v0`` from ``my_envs``)."""
+    """A fresh working folder holding the user's ``my_envs`` module of the README; afterwards Gymnasium's
+    registry as it was (the README registers ``Chase-v0`` from ``my_envs``) with the experiments built from
+    it, and the modules that register ids on import forgotten if they were first imported here."""
     import gymnasium as gym
+
+    from rlcore.environments import gym_experiment
 
     (tmp_path / "my_envs.py").write_text("from tests.user_env import ChaseEnv as Chase  # noqa: F401\n")
     monkeypatch.syspath_prepend(str(tmp_path))
     monkeypatch.chdir(tmp_path)
-    before = dict(gym.registry)
+    before, modules, built = dict(gym.registry), set(sys.modules), dict(gym_experiment._BUILT)
     yield tmp_path
     gym.registry.clear()
     gym.registry.update(before)
+    gym_experiment._BUILT.clear()  # the experiments built from those registrations, too
+    gym_experiment._BUILT.update(built)
+    for name in {"my_envs", "tests.user_env"} - modules:  # imported here: a later import registers again
+        sys.modules.pop(name, None)
 
 
 def test_the_pages_examples_run_in_order_each_on_what_an_earlier_one_made(users_folder, capsys, monkeypatch):
