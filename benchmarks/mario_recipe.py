@@ -36,12 +36,13 @@ from common import emit  # noqa: E402
 SHARES = (0.5, 0.8, 0.9, 0.95)
 
 
-def parse_recipe(text: str):
-    """'flag:epochs=4,num_envs=16' -> (name, config) of the mario_ppo preset with those fields set."""
+def parse_recipe(text: str, precision: str):
+    """'flag:epochs=4,num_envs=16' -> (name, config) of the mario_ppo preset with those fields set;
+    ``precision`` unless the recipe names its own ('flag:precision=float32')."""
     from mario_ppo.experiment import EXPERIMENT
 
     preset, _, changes = text.partition(":")
-    cfg = EXPERIMENT.preset("ppo", preset)
+    cfg = dataclasses.replace(EXPERIMENT.preset("ppo", preset), precision=precision)
     for change in filter(None, changes.split(",")):
         field, _, value = change.partition("=")
         kind = type(getattr(cfg, field))
@@ -49,7 +50,7 @@ def parse_recipe(text: str):
     return text, cfg
 
 
-def time_rollouts(cfg, rollouts: int, world: int, stage: int, precision: str) -> dict:
+def time_rollouts(cfg, rollouts: int, world: int, stage: int) -> dict:
     """Train ``rollouts`` rollouts in a scratch folder; the median collect/update seconds per rollout."""
     import pandas as pd
 
@@ -58,7 +59,7 @@ def time_rollouts(cfg, rollouts: int, world: int, stage: int, precision: str) ->
     from rlcore.training.spec import RunSpec
 
     steps = rollouts * cfg.n_steps * cfg.num_envs
-    cfg = dataclasses.replace(cfg, max_env_steps=steps, precision=precision, world=world, stage=stage,
+    cfg = dataclasses.replace(cfg, max_env_steps=steps, world=world, stage=stage,
                               checkpoint_rollouts=10**6)
     folder = Path(tempfile.mkdtemp(prefix="bench_recipe_"))
     spec = RunSpec(EXPERIMENT, "ppo", "bench", cfg, 0, "off", folder, command="benchmark", progress=False)
@@ -68,21 +69,22 @@ def time_rollouts(cfg, rollouts: int, world: int, stage: int, precision: str) ->
     collect, update = float(table["collect_seconds"].median()), float(table["update_seconds"].median())
     transitions = cfg.n_steps * cfg.num_envs
     return {"transitions_per_rollout": transitions, "epochs": cfg.epochs, "minibatch": cfg.minibatch,
+            "precision": cfg.precision,
             "collect_s": round(collect, 2), "update_s": round(update, 2),
             "env_steps_per_s": round(transitions / (collect + update), 1)}
 
 
 def bench_speed(recipes: list[str], rounds: int, rollouts: int, level: str, precision: str) -> None:
     world, stage = (int(x) for x in level.split("-"))
-    parsed = [parse_recipe(text) for text in recipes]
+    parsed = [parse_recipe(text, precision) for text in recipes]
     seen: dict[str, list[dict]] = {name: [] for name, _ in parsed}
     for round_ in range(rounds):
         for name, cfg in parsed:
-            row = time_rollouts(cfg, rollouts, world, stage, precision)
+            row = time_rollouts(cfg, rollouts, world, stage)
             seen[name].append(row)
-            emit(bench="recipe_speed", recipe=name, round=round_, level=level, precision=precision, **row)
+            emit(bench="recipe_speed", recipe=name, round=round_, level=level, **row)
     for name, rows in seen.items():
-        emit(bench="recipe_speed_median", recipe=name, level=level, precision=precision, rounds=rounds,
+        emit(bench="recipe_speed_median", recipe=name, level=level, precision=rows[0]["precision"], rounds=rounds,
              env_steps_per_s=round(float(np.median([r["env_steps_per_s"] for r in rows])), 1),
              collect_s=round(float(np.median([r["collect_s"] for r in rows])), 2),
              update_s=round(float(np.median([r["update_s"] for r in rows])), 2))
@@ -124,7 +126,8 @@ def main():
     parser.add_argument("--rounds", type=int, default=2, help="times each recipe is timed (A B A B ...)")
     parser.add_argument("--rollouts", type=int, default=3, help="rollouts per timing (the first one compiles)")
     parser.add_argument("--level", default="1-1", help="world-stage to time on")
-    parser.add_argument("--precision", default="bfloat16", choices=["float32", "bfloat16"])
+    parser.add_argument("--precision", default="bfloat16", choices=["float32", "bfloat16"],
+                        help="of every recipe that does not name its own")
     parser.add_argument("--skip-speed", action="store_true", help="only read the runs given")
     parser.add_argument("--runs", nargs="*", type=Path, default=[], help="run folders to read steps to shares from")
     args = parser.parse_args()

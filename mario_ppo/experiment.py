@@ -167,6 +167,11 @@ FLAG = dataclasses.replace(
     entropy_halve_at=(0.1, 0.3, 0.5, 0.7), stop_success_share=0.95, max_env_steps=10_000_000)
 
 LEVEL_NAMES = ("1-1", "1-2", "1-3", "1-4", "2-1", "2-2", "2-3", "2-4")  # the levels article 001 tried
+# what others published per level: article 001 (its last section: every level but 1-3 reached the end) and the
+# Stable-Baselines3 Mario models published with 100-episode evaluations (SPEC.md, issue 63)
+SB3 = {"1-1": "100 %", "1-2": "97-100 %", "1-4": "97-100 %", "2-1": "82 %", "2-3": "98 %"}
+PUBLISHED = {level: f"article 001: {'never reached the end' if level == '1-3' else 'reached the end'}; SB3 (100 episodes): "
+                    f"{SB3.get(level, 'none published')}" for level in LEVEL_NAMES}
 
 EXPERIMENT = Experiment(
     name="mario_ppo",
@@ -178,15 +183,18 @@ EXPERIMENT = Experiment(
     video_fps=60,
     env_fields=("world", "stage", "actions", "score_reward", "stall_steps", "stall_outcome",
                 "frames", "dead_ends"),
-    bars={level: Bar("success_share", 0.8 if level == "1-1" else 0.5,
-                     "article 001 reached the flag on every level from 1-1 to 2-4 but 1-3; we ask it in at "
-                     "least 5 of 10 unseen-seed episodes on each level, and 8 of 10 on 1-1, the first level",
-                     over_seeds=SeedsBar("median", 0.8, 3, "1-1's recipe from one command: its bar on the median "
-                                                           "of its seeds, and the other levels' bar on every seed",
-                                         least=0.5)
+    # issue 63: the level of the Mario models people can download (PUBLISHED), judged on 30 episodes, where 10
+    # could not tell a share of 44 % from one of 97 %
+    bars={level: Bar("success_share", 0.9, published=PUBLISHED[level], reason=
+                     "the Mario models people can download reach the flag in 82-100 % of episodes (article 001 "
+                     "reached it on every level from 1-1 to 2-4 but 1-3); we ask it in at least 27 of 30 "
+                     "unseen-seed episodes on every level",
+                     over_seeds=SeedsBar("median", 0.8, 3, "1-1's recipe from one command (issue 49): the flag in "
+                                                           "80 % of episodes on the median of its seeds, and in 50 % "
+                                                           "on every seed", least=0.5)
                      if level == "1-1" else None) for level in LEVEL_NAMES},
     info_keys=("stalled", "start_x", "killed_by"),
-    eval_episodes=10, score_label="return (shaped, /10)",
+    eval_episodes=30, score_label="return (shaped, /10)",
     # the flag is the goal; x_pos how far Mario got; killed_by what ended a failed episode
     goal=Goal(success_key="flag_get", progress_key="x_pos", cause_key="killed_by", cause_name=cause_name),
     # restarts (training only): restarted episodes start at start_x; the routes to each kept restart

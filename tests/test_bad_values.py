@@ -398,11 +398,11 @@ def test_publish_refusal_reads_the_bar_of_the_folder_it_would_replace():
     assert "misses the bar of the shipped a2c (mean return >= 200)" in publish_refusal(
         lander, Path("saved/lunar_lander/a2c"), {"evaluation": {"mean": 199.0, "episodes": 100}})
     assert "no evaluation on unseen seeds" in publish_refusal(lander, Path("saved/lunar_lander/dqn"), {})
-    assert "its evaluation has 1 episodes; a shipped model's has 10" in publish_refusal(
-        mario, Path("saved/mario_ppo/1-2"), {"evaluation": {"success_share": 1.0, "episodes": 1}})
-    flags = {"evaluation": {"success_share": 0.6, "episodes": 10}}  # 6 of 10: enough for 1-2, not for 1-1
-    assert publish_refusal(mario, Path("saved/mario_ppo/1-2"), flags) is None
-    assert "1-1 (flag in >= 80% of episodes)" in publish_refusal(mario, Path("saved/mario_ppo/1-1"), flags)
+    assert "its evaluation has 10 episodes; a shipped model's has 30" in publish_refusal(
+        mario, Path("saved/mario_ppo/1-2"), {"evaluation": {"success_share": 1.0, "episodes": 10}})
+    assert publish_refusal(mario, Path("saved/mario_ppo/1-2"), {"evaluation": {"success_share": 0.9, "episodes": 30}}) is None
+    flags = {"evaluation": {"success_share": 26 / 30, "episodes": 30}}  # 26 of 30: short of the bar on every level
+    assert "2-2 (flag in >= 90% of episodes)" in publish_refusal(mario, Path("saved/mario_ppo/2-2"), flags)
 
 
 def test_a_folder_that_takes_no_new_files_is_said_so_not_missing():

@@ -65,6 +65,7 @@ class Bar:
     reason: str
     full_length_share: float | None = None
     over_seeds: SeedsBar | None = None  # what the recipe must reach over seeds, where a bar is set for it
+    published: str | None = None  # what others published for the same task, with the source (the results tables)
 
     def met_by(self, evaluation: dict) -> bool:
         """Whether a recorded evaluation (meta.json's ``evaluation``) clears the bar."""

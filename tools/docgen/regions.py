@@ -3,6 +3,7 @@ and ``<!-- /generated -->`` is region NAME with ARG (:data:`REGIONS`); the rest 
 The regions about the shipped models are here; the others in :mod:`.reference` and :mod:`.sweeps`."""
 import re
 
+from rlcore.runs.commands import cpus_text
 from rlcore.runs.score_words import hours, success_word
 from tools.docgen import reference, sweeps
 from tools.docgen.data import REPO, shipped_models
@@ -68,22 +69,27 @@ def region_gif_strip(page: str, arg: str) -> str:
 
 
 def region_shipped(page: str, experiment: str) -> str:
-    """The shipped models of one experiment with their training counters and unseen-seed score; a model
-    whose run started from another's weights (``--init-from``) also gives what the chain cost."""
+    """The shipped models of one experiment with their training counters, commands, CPU and unseen-seed score,
+    beside what others published; a model whose run started from another's weights (``--init-from``) also gives
+    what the chain cost. A column no model fills is left out."""
     models = [m for m in shipped_models() if m.experiment == experiment]
-    chained = any(m.lineage for m in models)
+    header = ["model", "preset", "commands", "env steps", "episodes", "wall",
+              "env steps, wall with the runs it started from (`--init-from`)", "best selection eval", "CPU",
+              "unseen seeds", "bar", "published elsewhere"]
     rows = []
     for m in models:
         meta, best, (steps, seconds) = m.meta, m.meta.get("best_eval") or {}, m.from_scratch()
         sources = ", ".join(source(parent, m.name) for parent in m.lineage)
-        chain = [f"{steps:,}, {hours(seconds)} (from {sources})" if m.lineage else "–"] if chained else []
-        rows.append([f"[{m.name}]({link(page, card_path(m, page))})", f"`{meta.get('preset')}`",
-                     f"{meta['env_steps']:,}", f"{meta['episodes']:,}", hours(meta["wall_seconds"]), *chain,
-                     ret(best["mean"]) if "mean" in best else "–",
-                     f"**{score_text(m)}** ({m.evaluation.get('episodes', '?')} ep.)", bar_text(m, met=": ")])
-    cost = ["env steps, wall with the runs it started from (`--init-from`)"] if chained else []
-    header = ["model", "preset", "env steps", "episodes", "wall", *cost, "best selection eval", "unseen seeds", "bar"]
-    return table(header, rows, "llrrr" + ("r" if chained else "") + "rll")
+        commands = str(len(meta["commands"])) if meta.get("commands") else "–"
+        rows.append([f"[{m.name}]({link(page, card_path(m, page))})", f"`{meta.get('preset')}`", commands,
+                     f"{meta['env_steps']:,}", f"{meta['episodes']:,}", hours(meta["wall_seconds"]),
+                     f"{steps:,}, {hours(seconds)} (from {sources})" if m.lineage else "–",
+                     ret(best["mean"]) if "mean" in best else "–", cpus_text(meta) or "–",
+                     f"**{score_text(m)}** ({m.evaluation.get('episodes', '?')} ep.)", bar_text(m, met=": "),
+                     (m.bar.published if m.bar else None) or "–"])
+    kept = [i for i in range(len(header)) if i < 2 or any(row[i] != "–" for row in rows)]
+    return table([header[i] for i in kept], [[row[i] for i in kept] for row in rows],
+                 "".join("llrrrrrrllll"[i] for i in kept))
 
 
 def source(parent: dict, name: str) -> str:
