@@ -351,6 +351,34 @@ def test_publish_replaces_the_shipped_folder_whole(tmp_path):
     assert [p.name for p in target.parent.iterdir()] == ["dqn"]  # no temporary folder left
 
 
+def test_a_model_published_over_another_records_what_it_replaced_and_its_card_says_so(tmp_path):
+    """Issue 63: a level's one-command model shows the score of the hand-steered model it replaced."""
+    import json
+
+    from rlcore.models.shipping import publish
+    from tools.docgen.cards import replaced_text
+
+    model, target = tmp_path / "run" / "model", tmp_path / "saved" / "1-2"
+    model.mkdir(parents=True)
+    target.mkdir(parents=True)
+    (model / "meta.json").write_text(json.dumps({"preset": "flag", "commands": ["train"], "env_steps": 9}))
+    first = {"preset": "levels", "env_steps": 100, "wall_seconds": 3600, "commands": ["a", "b"]}
+    (target / "meta.json").write_text(json.dumps({
+        "preset": "default", "env_steps": 50, "wall_seconds": 1800, "commands": ["c", "d", "e"], "init_from": first,
+        "evaluation": {"episodes": 30, "success_share": 0.5, "seeds": "1000000..1000029", "per_episode": [{}] * 30}}))
+    publish(model, target)
+    meta = json.loads((target / "meta.json").read_text())
+    assert meta["env_steps"] == 9 and meta["replaces"] == {
+        "preset": "default", "commands": 3, "env_steps": 150, "wall_seconds": 5400, "finished": None,
+        "evaluation": {"episodes": 30, "success_share": 0.5, "seeds": "1000000..1000029"}}
+
+    class Model:
+        experiment, name = "mario_ppo", "1-2"
+    assert replaced_text(meta["replaces"], Model) == ("flag in 15 of 30 (seeds 1000000..1000029); trained by 3 commands "
+                                                      "(`default` preset), 150 env steps, 1.5 h")
+    assert replaced_text(None, Model) is None
+
+
 def test_a_new_run_into_a_folder_that_holds_a_run_is_refused_and_leaves_it_as_it_was(capsys, tmp_path):
     """Starting again with the first command of a long run (not --resume) must not touch its files."""
     run_dir = tmp_path / "run"

@@ -300,10 +300,35 @@ def publish(model_dir: Path, target: Path) -> None:
     """Make ``target`` (a saved_networks/ folder) an exact copy of ``model_dir``, replacing it whole
     (:func:`rlcore.files.atomic.replace_folder`: files of an earlier model that the new one lacks do not
     survive, and a crash leaves the old folder or the new one, never a mix)."""
-    from rlcore.files.atomic import replace_folder
+    from rlcore.files.atomic import replace_folder, write_json
+    from rlcore.files.model_meta import read_meta
+
+    replaced = replaced_record(target)
 
     def fill(fresh: Path) -> None:
         for src in sorted(p for p in model_dir.iterdir() if p.is_file()):
             shutil.copyfile(src, fresh / src.name)
+        if replaced:  # the card gives the score of the model it replaced beside its own
+            write_json(fresh / "meta.json", {**read_meta(fresh), "replaces": replaced})
 
     replace_folder(target, fill)
+
+
+def replaced_record(target: Path) -> dict | None:
+    """What the shipped model at ``target`` was, for the meta.json of the model that replaces it: its evaluation
+    (without its episodes), its number of commands, and the env steps and wall seconds it cost with the runs it
+    started from (``--init-from``). None where nothing readable is shipped there."""
+    from rlcore.files.model_meta import read_meta
+
+    try:
+        meta, runs = read_meta(target), []
+    except UserError:  # nothing shipped there, or a damaged record the new model repairs
+        return None
+    parent = meta
+    while isinstance(parent, dict):
+        runs.append(parent)
+        parent = parent.get("init_from")
+    evaluation = {k: v for k, v in (meta.get("evaluation") or {}).items() if k not in ("per_episode", "machine")}
+    return {"preset": meta.get("preset"), "commands": len(meta.get("commands") or []), "evaluation": evaluation,
+            "env_steps": sum(r.get("env_steps", 0) for r in runs),
+            "wall_seconds": sum(r.get("wall_seconds", 0) for r in runs), "finished": meta.get("finished")}

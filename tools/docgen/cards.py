@@ -5,6 +5,7 @@ import json
 from rlcore.algorithms.registry import FAMILIES
 from rlcore.environments.registry import experiment_names, get_experiment
 from rlcore.hyperparams.flags import to_dict
+from rlcore.runs.score_words import hours, score_words
 from tools.docgen.data import REPO
 from tools.docgen.reference import region_bars
 from tools.docgen.regions import OVER_SEEDS_HEADER, experiment_page, region_shipped, region_sweeps
@@ -106,7 +107,19 @@ def score_fields(m) -> dict:
         time_limit_share=f"{ev['time_limit_share']:.0%}" if "time_limit_share" in ev and not share else None,
         walked=f"{ev['mean_x']:,.1f} m" if "mean_x" in ev and not share else None,
         bar=bar_text(m, met=": "), bar_reason=m.bar.reason if m.bar else None,
-        best_eval=f"{ret(best['mean'])} at {best.get('env_steps', 0):,} env steps" if "mean" in best else None)
+        best_eval=f"{ret(best['mean'])} at {best.get('env_steps', 0):,} env steps" if "mean" in best else None,
+        replaced=replaced_text(m.meta.get("replaces"), m))
+
+
+def replaced_text(old: dict | None, m) -> str | None:
+    """The shipped model this one replaced (``main.py train --publish``): its score, and what training it cost."""
+    if not old:
+        return None
+    ev, commands = old.get("evaluation") or {}, old.get("commands") or 0
+    score = score_words(ev, m.experiment, m.name) if ev else "not evaluated"
+    seeds = f" (seeds {ev['seeds']})" if ev.get("seeds") else ""
+    return (f"{score}{seeds}; trained by {commands or 'unrecorded'} command{'s' * (commands != 1)} "
+            f"(`{old.get('preset')}` preset), {old.get('env_steps', 0):,} env steps, {hours(old.get('wall_seconds', 0))}")
 
 
 def over_seeds_text(m, page: str) -> str:
