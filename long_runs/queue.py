@@ -14,7 +14,8 @@ again at any time. Stop it with SIGTERM or Ctrl-C to its process group (``kill -
 queue prints its PGID): the running training writes its checkpoint and exits, and the queue starts
 nothing more. A step that fails stops the queue with that step's exit status, and so does a step that
 ends well but leaves the folders as they were (it would run again forever). Shipping a finished level
-(its model, card and GIF) is left to a person, who reads the result first.
+(its model, card and GIF) is left to a person, who reads the result first (``long_runs/README.md`` says how);
+the queue then reads that level's run from its ``saved_networks/`` folder.
 
 A training run from a worktree at a fixed commit (``git worktree add --detach ../runner``, its
 ``long_runs/mario_ppo`` a symlink to this one's) cannot be reached by code changed here meanwhile; its
@@ -45,6 +46,16 @@ def run_dir(name: str) -> str:
     return f"long_runs/mario_ppo/{name}"
 
 
+def shipped(name: str, folders: Path = HERE) -> Path | None:
+    """Where a level's run lives once it is published (``--publish`` copies its model, CSV tables and meta.json
+    into saved_networks/, and its long_runs folder is then deleted): that folder; None while it is not."""
+    level, extra = next((level, extra) for run, level, extra in RUNS if run == name)
+    target = folders / "saved_networks" / "mario_ppo" / level
+    if extra or (folders / run_dir(name)).exists() or not (target / "meta.json").is_file():
+        return None
+    return target if json.loads((target / "meta.json").read_text()).get("preset") == RECIPE[1] else None
+
+
 def train_command(name: str, level: str, extra: list[str]) -> list[str]:
     world, stage = level.split("-")
     return ["train", "mario_ppo", "ppo", *RECIPE, "--world", world, "--stage", stage, *extra,
@@ -56,6 +67,8 @@ def next_command(folders: Path = HERE) -> list[str] | None:
     when the queue has nothing left to run."""
     for name, level, extra in RUNS:
         run = folders / run_dir(name)
+        if shipped(name, folders):
+            continue
         meta = run / "model" / "meta.json"
         if meta.is_file():
             if not _evaluated(meta):  # trained, but the process ended before its final evaluation
@@ -78,14 +91,15 @@ def _evaluated(meta: Path) -> bool:
 def run_status(name: str, folders: Path = HERE) -> str:
     """One line: queued, at a checkpoint (env steps, episodes, the flag share of the last 100 episodes from
     the level's start), or finished (what ended it, and the flag on unseen seeds)."""
-    run = folders / run_dir(name)
-    meta = run / "model" / "meta.json"
+    run, home = folders / run_dir(name), shipped(name, folders)
+    meta = home / "meta.json" if home else run / "model" / "meta.json"
     if meta.is_file():
         record = json.loads(meta.read_text())
         scores = [record.get("evaluation") or {}] + list(record.get("further_evaluations") or [])
         flags = ", ".join(f"{round(e['success_share'] * e['episodes'])} of {e['episodes']}" for e in scores
                           if "success_share" in e and "episodes" in e)
-        return (f"{name}: finished at {record.get('env_steps', 0):,} env steps ({record.get('stopped_by', '?')}); "
+        return (f"{name}: {f'shipped to {home.relative_to(folders)}, ' if home else ''}finished at "
+                f"{record.get('env_steps', 0):,} env steps ({record.get('stopped_by', '?')}); "
                 f"flag on unseen seeds: {flags or 'not evaluated yet'}")
     if (run / "checkpoint.npz").is_file():
         return f"{name}: in progress (a checkpoint kept); " + _progress(run / "metrics.csv")
@@ -155,7 +169,7 @@ def plot(path: Path, folders: Path = HERE) -> None:
         ax.plot([s / 1e6 for s in steps], shares, color="silver", linewidth=0.8,
                 label="1-1, default preset (3 seeds)" if i == 0 else None)
     for name, _, extra in RUNS:
-        steps, shares = flag_curve(folders / run_dir(name) / "metrics.csv")
+        steps, shares = flag_curve((shipped(name, folders) or folders / run_dir(name)) / "metrics.csv")
         if steps:
             ax.plot([s / 1e6 for s in steps], shares, label=name, linestyle="--" if extra else "-", linewidth=1.2)
     ax.axhline(0.9, color="gray", linewidth=0.8, linestyle=":", label="bar: 27 of 30")

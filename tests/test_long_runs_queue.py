@@ -106,6 +106,25 @@ def test_status_says_where_each_run_stands(tmp_path):
                                                  "unseen seeds: 27 of 30, 30 of 30")
 
 
+def test_a_shipped_level_is_done_and_read_from_its_model_folder(tmp_path):
+    """Once published, a level's run lives in saved_networks/ and its long_runs folder is deleted: the queue moves
+    on, says where it went and draws its curve from there; a hand-steered model shipped there is not the run."""
+    target = tmp_path / "saved_networks" / "mario_ppo" / "1-1"
+    target.mkdir(parents=True)
+    (target / "meta.json").write_text(json.dumps({"preset": "default", "env_steps": 7}))
+    assert queue.shipped("1-1", tmp_path) is None and queue.next_command(tmp_path) == queue.train_command("1-1", "1-1", [])
+    (target / "meta.json").write_text(json.dumps({"preset": "flag", "env_steps": 7, "stopped_by": "stop_success_share 0.95",
+                                                  "evaluation": {"success_share": 0.9, "episodes": 30}}))
+    (target / "metrics.csv").write_text("episode,success,env_steps,restarted\n" + "".join(
+        f"{i},1,{100 * i},0\n" for i in range(1, 101)))
+    assert queue.shipped("1-1", tmp_path) == target and queue.shipped("1-1-epochs-4", tmp_path) is None
+    assert queue.next_command(tmp_path) == queue.train_command("1-1-epochs-4", "1-1", ["--epochs", "4"])
+    assert queue.run_status("1-1", tmp_path) == ("1-1: shipped to saved_networks/mario_ppo/1-1, finished at 7 env steps "
+                                                 "(stop_success_share 0.95); flag on unseen seeds: 27 of 30")
+    queue.plot(tmp_path / "plot.png", tmp_path)
+    assert (tmp_path / "plot.png").stat().st_size > 0
+
+
 def test_the_flag_curve_counts_the_last_100_episodes_from_the_levels_start(tmp_path):
     """Restarted episodes (begun mid-level) stay out of the share, as out of the recipe's stop rule; the
     curve starts at the 100th episode from the start. The figure is written whole, beside no other file."""
