@@ -193,6 +193,9 @@ EXPERIMENT = Experiment(
                                                            "80 % of episodes on the median of its seeds, and in 50 % "
                                                            "on every seed", least=0.5)
                      if level == "1-1" else None) for level in LEVEL_NAMES},
+    below_bar={level: "trained before the bar of 27 of 30 was set (2026-12-07), by resumes steered by hand; it ships "
+                      "until the level's run from one command (`long_runs/`, issue 63) replaces it"
+               for level in ("1-1", "1-2", "1-4", "2-1", "2-2", "2-3", "2-4")},
     info_keys=("stalled", "start_x", "killed_by"),
     eval_episodes=30, score_label="return (shaped, /10)",
     # the flag is the goal; x_pos how far Mario got; killed_by what ended a failed episode

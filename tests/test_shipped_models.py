@@ -33,8 +33,8 @@ LIVE_EPISODES = {"lunar_lander": 20, "cartpole": 5, "cartpole_v0": 5, "minitaur"
 # recorded episodes replayed exactly on the recording machine (default 5): one 1,000-step Minitaur episode
 # (a return that differs in its last digits shows any drift within it)
 REPLAYED_EPISODES = {"minitaur": 1}
-# a success-scored model (Mario, bar >= 50 % flags) plays sampled episodes until one reaches the flag:
-# with a true share of at least 1/2, ten misses in a row have a chance below 0.1 %
+# a success-scored model (Mario) plays sampled episodes until one reaches the flag: at the lowest recorded
+# share (1-2's 14 of 30), ten misses in a row have a chance of 0.2 %
 SUCCESS_TRIES = 10
 
 
@@ -123,11 +123,13 @@ def test_shipped_model_meets_its_bar(experiment, algo, folder):
         assert key in meta, key
     evaluation = meta["evaluation"]
     assert evaluation["episodes"] == exp.eval_episodes
-    assert bar.met_by(evaluation), (bar, {k: v for k, v in evaluation.items() if k != "per_episode"})
+    # met, unless the registry says why the model ships below its bar (and then not met, or the note is stale)
+    assert bar.met_by(evaluation) != (folder in exp.below_bar), (
+        bar, exp.below_bar.get(folder), {k: v for k, v in evaluation.items() if k != "per_episode"})
     recorded = evaluation["per_episode"]
     assert len(recorded) == exp.eval_episodes
     if exp.goal:
-        assert np.mean([r["success"] for r in recorded]) == pytest.approx(evaluation["success_share"])
+        assert np.mean([r["success"] for r in recorded]) == pytest.approx(evaluation["success_share"], abs=5e-4)  # kept to 3 decimals
     else:
         assert np.mean([r["return"] for r in recorded]) == pytest.approx(evaluation["mean"], abs=0.01)
     still_plays(exp, meta, policy, folder)

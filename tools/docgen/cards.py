@@ -107,6 +107,7 @@ def score_fields(m) -> dict:
         time_limit_share=f"{ev['time_limit_share']:.0%}" if "time_limit_share" in ev and not share else None,
         walked=f"{ev['mean_x']:,.1f} m" if "mean_x" in ev and not share else None,
         bar=bar_text(m, met=": "), bar_reason=m.bar.reason if m.bar else None,
+        below_bar=get_experiment(m.experiment).below_bar.get(m.name) if bar_met(m) != "met" else None,
         best_eval=f"{ret(best['mean'])} at {best.get('env_steps', 0):,} env steps" if "mean" in best else None,
         replaced=replaced_text(m.meta.get("replaces"), m))
 
