@@ -200,14 +200,10 @@ def evaluate(model: ModelRef | Policy, episodes: int | None = None, seed_base: i
     check_whole("seed_base", seed_base, NON_NEGATIVE, none_ok=True)
     policy = load(model)
     count = shipping.eval_episodes(policy.experiment, episodes)
-    if record_further:
-        meta = shipping.evaluate_further_into_meta(policy.model_dir, count, seed_base)
-        policy.meta = meta
-        return dict(meta["further_evaluations"][-1])
-    if record:
-        meta = shipping.evaluate_into_meta(policy.model_dir, count, seed_base, replace=replace)
-        policy.meta = meta
-        return dict(meta["evaluation"])
+    if record or record_further:
+        policy.meta = shipping.record_evaluation(policy.model_dir, count, seed_base, further=record_further,
+                                                 replace=replace)
+        return dict(policy.meta["further_evaluations"][-1] if record_further else policy.meta["evaluation"])
     summary, line = shipping.run_evaluation(policy.experiment, policy._network, count, seed_base, policy.meta)
     return {**summary, "line": line}
 

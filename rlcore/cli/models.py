@@ -97,10 +97,9 @@ def cmd_evaluate(args) -> int:
         raise UserError("--replace goes with --record (it lets the new evaluation overwrite the recorded one)")
     with _model(args) as (model_dir, name):
         if args.record or args.record_further:  # seeds checked before the model loads; it must match the names
-            record = shipping.evaluate_further_into_meta if args.record_further else shipping.evaluate_into_meta
             episodes = shipping.eval_episodes(shipping.experiment_of(model_dir), args.episodes)
-            extra = {} if args.record_further else {"replace": args.replace}
-            record(model_dir, episodes, args.seed_base, args.experiment, args.algo, **extra)
+            shipping.record_evaluation(model_dir, episodes, args.seed_base, args.experiment, args.algo,
+                                       further=args.record_further, replace=args.replace)
             print(f"recorded in {model_dir / 'meta.json'}" + (" (further_evaluations)" if args.record_further else ""))
             return 0
         exp, meta, policy = load_policy(model_dir, args.experiment, args.algo)

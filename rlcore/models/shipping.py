@@ -177,29 +177,43 @@ def _bar_words(exp, meta: dict | None, summary: dict, seed_base: int) -> str:
             + (f" ({'; '.join(caveats)})" if caveats else ""))
 
 
-def evaluate_into_meta(model_dir: Path, episodes: int, seed_base: int | None = None,
-                       experiment: str | None = None, algo: str | None = None, replace: bool = False) -> dict:
-    """Evaluate a model on unseen seeds and write the result into its meta.json as its ``evaluation``.
-    Refused when it records one already, unless ``replace`` (a shipped model's 100 episodes are not
-    overwritten by a 1-episode try), and when those seeds overlap a further evaluation already recorded
-    (it would no longer be held out)."""
+def record_evaluation(model_dir: Path, episodes: int, seed_base: int | None = None, experiment: str | None = None,
+                      algo: str | None = None, *, further: bool = False, replace: bool = False) -> dict:
+    """Evaluate a model on unseen seeds and write the result into its meta.json: as its ``evaluation`` (refused
+    over one recorded already unless ``replace``: a shipped model's 100 episodes are not overwritten by a
+    1-episode try), or with ``further`` added to its ``further_evaluations``, its evaluation kept (by default on
+    the seeds right after the last ones recorded: a held-out check on seeds nothing chose the model by). Seeds
+    another recorded evaluation played are refused: they would no longer be held out. Returns the meta."""
     from rlcore.files.atomic import write_json
     from rlcore.files.model_meta import read_meta
     from rlcore.host.machine import this_machine
     from rlcore.models.policies import load_policy
 
-    exp = experiment_of(model_dir)
-    recorded = read_meta(model_dir)
-    if recorded.get("evaluation") and not replace:
-        raise UserError(_replace_refusal(model_dir, recorded["evaluation"], exp, recorded))
-    seed_base = exp.eval_seed_base if seed_base is None else seed_base
-    _check_seeds_free(range(seed_base, seed_base + episodes), recorded.get("further_evaluations", []),
-                      "a further evaluation")
-    exp, meta, policy = load_policy(model_dir, experiment, algo)
-    meta["evaluation"], line = run_evaluation(exp, policy, episodes, seed_base, meta)
-    meta["evaluation"]["machine"] = this_machine()  # where these episodes replay exactly (rlcore.host.machine)
+    def others(meta: dict) -> list[dict]:  # the recorded evaluations the new one's seeds must keep clear of
+        return [ev for ev in [meta.get("evaluation") if further else None, *meta.get("further_evaluations", [])] if ev]
+
+    exp, meta = experiment_of(model_dir), read_meta(model_dir)
+    if meta.get("evaluation") and not (replace or further):
+        raise UserError(_replace_refusal(model_dir, meta["evaluation"], exp, meta))
+    if seed_base is None:
+        seed_base = max((seed_range(ev).stop for ev in others(meta)), default=exp.eval_seed_base) if further \
+            else exp.eval_seed_base
+    wanted = range(seed_base, seed_base + episodes)
+    if further and (wanted.start < exp.eval_seed_base or wanted.stop > exp.selection_seed_base):
+        raise UserError(f"--seed-base {seed_base} with {episodes} episodes plays seeds {wanted.start}..{wanted.stop - 1}, "
+                        f"outside {exp.name}'s unseen range {exp.eval_seed_base}..{exp.selection_seed_base - 1}")
+    _check_seeds_free(wanted, others(meta), "an evaluation" if further else "a further evaluation")
+    exp, loaded, policy = load_policy(model_dir, experiment, algo)
+    summary, line = run_evaluation(exp, policy, episodes, seed_base, loaded)
+    summary["machine"] = this_machine()  # where these episodes replay exactly (rlcore.host.machine)
+    meta = read_meta(model_dir)  # as it is now: another process may have recorded an evaluation meanwhile
+    _check_seeds_free(wanted, others(meta), "an evaluation" if further else "a further evaluation")
+    if further:
+        meta["further_evaluations"] = [*meta.get("further_evaluations", []), summary]
+    else:
+        meta["evaluation"] = summary
     write_json(model_dir / "meta.json", meta)
-    print(f"evaluation (unseen seeds): {line}")
+    print(f"{'further evaluation' if further else 'evaluation'} (unseen seeds): {line}")
     return meta
 
 
@@ -243,40 +257,6 @@ def experiment_of(model_dir: Path):
     if not meta.get("experiment"):
         raise UserError(f"{model_dir / 'meta.json'} names no experiment: not a model folder of this package")
     return get_experiment(meta["experiment"], meta.get("env"))
-
-
-def evaluate_further_into_meta(model_dir: Path, episodes: int, seed_base: int | None = None,
-                               experiment: str | None = None, algo: str | None = None) -> dict:
-    """Evaluate a model again on unseen seeds that no recorded evaluation of it played, and add the
-    result to its meta.json's ``further_evaluations`` (its ``evaluation`` kept). By default the seeds
-    follow the last ones recorded. A held-out check: more episodes on seeds nothing chose the model by."""
-    from rlcore.files.atomic import write_json
-    from rlcore.files.model_meta import read_meta
-    from rlcore.host.machine import this_machine
-    from rlcore.models.policies import load_policy
-
-    def recorded_evaluations() -> list[dict]:
-        meta = read_meta(model_dir)
-        return [ev for ev in [meta.get("evaluation"), *meta.get("further_evaluations", [])] if ev]
-
-    exp = experiment_of(model_dir)
-    recorded = recorded_evaluations()
-    if seed_base is None:
-        seed_base = max((seed_range(ev).stop for ev in recorded), default=exp.eval_seed_base)
-    wanted = range(seed_base, seed_base + episodes)
-    if wanted.start < exp.eval_seed_base or wanted.stop > exp.selection_seed_base:
-        raise UserError(f"--seed-base {seed_base} with {episodes} episodes plays seeds {wanted.start}..{wanted.stop - 1}, "
-                        f"outside {exp.name}'s unseen range {exp.eval_seed_base}..{exp.selection_seed_base - 1}")
-    _check_seeds_free(wanted, recorded, "an evaluation")
-    exp, loaded, policy = load_policy(model_dir, experiment, algo)
-    summary, line = run_evaluation(exp, policy, episodes, seed_base, loaded)
-    summary["machine"] = this_machine()
-    _check_seeds_free(wanted, recorded_evaluations(), "an evaluation")  # another process may have recorded some
-    meta = read_meta(model_dir)
-    meta["further_evaluations"] = [*meta.get("further_evaluations", []), summary]
-    write_json(model_dir / "meta.json", meta)
-    print(f"further evaluation (unseen seeds): {line}")
-    return meta
 
 
 def publish_refusal(experiment, target: Path, meta: dict) -> str | None:

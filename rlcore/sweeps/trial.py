@@ -70,7 +70,7 @@ def _evaluate_trial(sweep: Sweep, run_dir: Path) -> dict:
     from rlcore.models import shipping
 
     episodes = shipping.eval_episodes(get_experiment(sweep.experiment), sweep.final_eval_episodes)
-    return shipping.evaluate_into_meta(run_dir / "model", episodes, replace=True)  # the trial's own model
+    return shipping.record_evaluation(run_dir / "model", episodes, replace=True)  # the trial's own model
 
 
 def log_trial(sweep: Sweep, trial: dict, event: str) -> None:
@@ -114,7 +114,7 @@ def _train_trial(trial: dict, sweep: Sweep, run_dir: Path, report) -> dict:
     except Interrupted:
         return {"interrupted": 1}
     episodes = shipping.eval_episodes(spec.experiment, sweep.final_eval_episodes)
-    meta = (shipping.evaluate_into_meta(model_dir, episodes, replace=True) if episodes > 0
+    meta = (shipping.record_evaluation(model_dir, episodes, replace=True) if episodes > 0
             else json.loads((model_dir / "meta.json").read_text()))
     return final_metrics(meta)
 

@@ -222,5 +222,5 @@ def train_and_evaluate(spec: RunSpec, on_progress: Callable[[dict, str], None] |
         f"{meta['wall_seconds']:.0f} s; last-100 average {meta['final_average']:.1f}")
     episodes = shipping.eval_episodes(spec.experiment, spec.final_eval_episodes)
     if episodes > 0:
-        meta = shipping.evaluate_into_meta(model_dir, episodes, replace=True)  # the model just trained
+        meta = shipping.record_evaluation(model_dir, episodes, replace=True)  # the model just trained
     return model_dir, meta
