@@ -170,8 +170,8 @@ LEVEL_NAMES = ("1-1", "1-2", "1-3", "1-4", "2-1", "2-2", "2-3", "2-4")  # the le
 # what others published per level: article 001 (its last section: every level but 1-3 reached the end) and the
 # Stable-Baselines3 Mario models published with 100-episode evaluations (SPEC.md, issue 63)
 SB3 = {"1-1": "100 %", "1-2": "97-100 %", "1-4": "97-100 %", "2-1": "82 %", "2-3": "98 %"}
-PUBLISHED = {level: f"article 001: {'never reached the end' if level == '1-3' else 'reached the end'}; SB3 (100 episodes): "
-                    f"{SB3.get(level, 'none published')}" for level in LEVEL_NAMES}
+PUBLISHED = {level: f"article 001: {'no' if level == '1-3' else 'yes'}; SB3: "
+                    + (f"{SB3[level]} of 100" if level in SB3 else "none") for level in LEVEL_NAMES}
 
 EXPERIMENT = Experiment(
     name="mario_ppo",

@@ -84,7 +84,7 @@ def region_shipped(page: str, experiment: str) -> str:
         rows.append([f"[{m.name}]({link(page, card_path(m, page))})", f"`{meta.get('preset')}`", commands,
                      f"{meta['env_steps']:,}", f"{meta['episodes']:,}", hours(meta["wall_seconds"]),
                      f"{steps:,}, {hours(seconds)} (from {sources})" if m.lineage else "–",
-                     ret(best["mean"]) if "mean" in best else "–", re.sub(r" \([^)]*\)", "", cpus_text(meta) or "–"),
+                     ret(best["mean"]) if "mean" in best else "–", re.sub(r" \([^)]*\)|\(R\)| Processor", "", cpus_text(meta) or "–"),
                      f"**{score_text(m)}** ({m.evaluation.get('episodes', '?')} ep.)", bar_text(m, met=": "),
                      (m.bar.published if m.bar else None) or "–"])
     kept = [i for i in range(len(header)) if i < 2 or any(row[i] != "–" for row in rows)]
