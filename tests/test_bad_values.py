@@ -417,6 +417,33 @@ def test_publish_refuses_a_model_that_misses_the_bar_of_the_one_it_would_replace
     assert (run_dir / "model" / "meta.json").is_file()
 
 
+def test_a_finished_run_resumed_with_publish_replaces_the_shipped_model_and_records_it(capsys, tmp_path, monkeypatch):
+    """How a Mario level of the queue ships (long_runs/README.md): `train --resume RUN --publish` on a finished
+    run evaluates it again and replaces the shipped folder whole, whose score the new meta.json keeps."""
+    import json
+
+    from rlcore.environments.experiment import Bar
+    from rlcore.environments.registry import get_experiment
+
+    monkeypatch.setitem(get_experiment("cartpole").bars, "dqn", Bar("mean", -1.0, "any score, for this test"))
+    shipped = tmp_path / "models" / "cartpole" / "dqn"
+    shipped.mkdir(parents=True)
+    (shipped / "meta.json").write_text(json.dumps({"preset": "article", "commands": ["a", "b"], "env_steps": 5,
+                                                   "evaluation": {"episodes": 100, "mean": 9.5, "std": 0.5}}))
+    (shipped / "old_plot.png").write_bytes(b"")
+    monkeypatch.setenv("DEEPRL_MODELS", str(tmp_path / "models"))
+    run_dir = tmp_path / "run"
+    args = ["cartpole", "dqn", "--wandb", "off", "--no-progress"]
+    code, out, err = run(capsys, "train", *args, "--episodes", "3", "--run-dir", str(run_dir))
+    assert code == 0, (out, err)
+    code, out, err = run(capsys, "train", *args, "--resume", str(run_dir), "--publish")
+    assert code == 0 and f"published to {shipped}/" in out, (out, err)
+    meta = json.loads((shipped / "meta.json").read_text())
+    assert meta["evaluation"]["episodes"] == 100 and not (shipped / "old_plot.png").exists()
+    assert meta["replaces"] == {"preset": "article", "commands": 2, "env_steps": 5, "wall_seconds": 0, "finished": None,
+                                "evaluation": {"episodes": 100, "mean": 9.5, "std": 0.5}}
+
+
 def test_publish_refusal_reads_the_bar_of_the_folder_it_would_replace():
     from rlcore.environments.registry import get_experiment
     from rlcore.models.shipping import publish_refusal
