@@ -33,7 +33,8 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parents[1]
 # the recipe, fixed before the first run (issue 63): the flag preset; bfloat16 where the CPU has it
-RECIPE = ["--preset", "flag", "--seed", "0", "--precision", "bfloat16", "--final-eval-episodes", "30"]
+PRESET = "flag"
+RECIPE = ["--preset", PRESET, "--seed", "0", "--precision", "bfloat16", "--final-eval-episodes", "30"]
 QUIET = ["--wandb", "offline", "--no-progress"]
 LEVELS = ("1-1", "1-2", "1-3", "1-4", "2-1", "2-2", "2-3", "2-4")
 # (folder name, level, what the run adds to the recipe), in the order they train
@@ -53,7 +54,7 @@ def shipped(name: str, folders: Path = HERE) -> Path | None:
     target = folders / "saved_networks" / "mario_ppo" / level
     if extra or (folders / run_dir(name)).exists() or not (target / "meta.json").is_file():
         return None
-    return target if json.loads((target / "meta.json").read_text()).get("preset") == RECIPE[1] else None
+    return target if json.loads((target / "meta.json").read_text()).get("preset") == PRESET else None
 
 
 def train_command(name: str, level: str, extra: list[str]) -> list[str]:

@@ -38,3 +38,19 @@ def read_json(path: Path, fix: str) -> dict:
     if not isinstance(data, dict):
         raise UserError(f"{path} is damaged (it holds no JSON object); {fix}")
     return data
+
+
+def lineage(meta: dict) -> list[dict]:
+    """The runs whose weights a model's run started from (``--init-from``), nearest first, as its meta.json
+    records them; empty for a model trained from scratch."""
+    chain, parent = [], meta.get("init_from")
+    while isinstance(parent, dict):
+        chain.append(parent)
+        parent = parent.get("init_from")
+    return chain
+
+
+def cost_from_scratch(meta: dict) -> tuple[int, float]:
+    """Env steps and wall seconds of a model's run and of every run it started from: what the model cost."""
+    runs = [meta, *lineage(meta)]
+    return sum(r.get("env_steps", 0) for r in runs), sum(r.get("wall_seconds", 0.0) for r in runs)

@@ -298,17 +298,13 @@ def replaced_record(target: Path) -> dict | None:
     """What the shipped model at ``target`` was, for the meta.json of the model that replaces it: its evaluation
     (without its episodes), its number of commands, and the env steps and wall seconds it cost with the runs it
     started from (``--init-from``). None where nothing readable is shipped there."""
-    from rlcore.files.model_meta import read_meta
+    from rlcore.files.model_meta import cost_from_scratch, read_meta
 
     try:
-        meta, runs = read_meta(target), []
+        meta = read_meta(target)
     except UserError:  # nothing shipped there, or a damaged record the new model repairs
         return None
-    parent = meta
-    while isinstance(parent, dict):
-        runs.append(parent)
-        parent = parent.get("init_from")
-    evaluation = {k: v for k, v in (meta.get("evaluation") or {}).items() if k not in ("per_episode", "machine")}
-    return {"preset": meta.get("preset"), "commands": len(meta.get("commands") or []), "evaluation": evaluation,
-            "env_steps": sum(r.get("env_steps", 0) for r in runs),
-            "wall_seconds": sum(r.get("wall_seconds", 0) for r in runs), "finished": meta.get("finished")}
+    (env_steps, wall_seconds), evaluation = cost_from_scratch(meta), meta.get("evaluation") or {}
+    return {"preset": meta.get("preset"), "commands": len(meta.get("commands") or []),
+            "evaluation": {k: v for k, v in evaluation.items() if k not in ("per_episode", "machine")},
+            "env_steps": env_steps, "wall_seconds": wall_seconds, "finished": meta.get("finished")}

@@ -7,6 +7,7 @@ from pathlib import Path
 
 from rlcore.environments.experiment import Bar
 from rlcore.environments.registry import experiment_names, get_experiment
+from rlcore.files.model_meta import cost_from_scratch, lineage
 
 REPO = Path(__file__).resolve().parents[2]
 #: the Gymnasium id each experiment's models play (Mario's depends on the level)
@@ -54,18 +55,12 @@ class Model:
 
     @property
     def lineage(self) -> list[dict]:
-        """The runs whose weights this model's run started from (``--init-from``), nearest first, as
-        meta.json records them; empty for a model trained from scratch."""
-        chain, parent = [], self.meta.get("init_from")
-        while isinstance(parent, dict):
-            chain.append(parent)
-            parent = parent.get("init_from")
-        return chain
+        """The runs whose weights this model's run started from (``--init-from``), nearest first."""
+        return lineage(self.meta)
 
     def from_scratch(self) -> tuple[int, float]:
         """Env steps and wall seconds of this run and every run it started from: what the model cost."""
-        runs = [self.meta, *self.lineage]
-        return sum(r.get("env_steps", 0) for r in runs), sum(r.get("wall_seconds", 0.0) for r in runs)
+        return cost_from_scratch(self.meta)
 
 
 def read_json(path: Path) -> dict:
