@@ -1,6 +1,6 @@
 """What every experiment shares, one subpackage per concern, from the bottom up: ``files``, ``host``,
 ``hyperparams``, ``environments``, ``networks``, ``algorithms`` (a folder per family and the one registry of
-families), ``training`` (one run), ``models`` (saved models), ``runs`` (reading a run back), ``sweeps``,
+families), ``training`` (one run), ``models`` (saved models), ``records`` (reading a run back), ``sweeps``,
 ``api`` and ``cli``; each ``__init__`` says what it holds and what it may import (docs/developer/layout.md).
 
 Nothing in here knows an environment by name; experiment packages (``lunar_lander`` ...) are found by

@@ -202,7 +202,7 @@ def test_list_writes_each_shipped_score_as_the_readme_does(capsys):
 
 
 def test_score_words_give_two_decimals_below_100_and_a_castles_axe():
-    from rlcore.runs.score_words import score_words
+    from rlcore.records.score_words import score_words
 
     assert score_words({"mean": 20.4512, "std": 3.987}, "minitaur", "sac") == "20.45 ± 3.99"
     assert score_words({"mean": 270.71, "std": 21.44}, "lunar_lander", "dqn", "+-") == "270.7 +- 21.4"
@@ -214,7 +214,7 @@ def test_the_evaluate_line_names_a_levels_success_from_the_models_meta():
     """`evaluate` on a castle says axe, as the README does: the level comes from the model's meta.json."""
     from rlcore.environments.registry import get_experiment
     from rlcore.models.shipping import model_name
-    from rlcore.runs.score_words import success_word
+    from rlcore.records.score_words import success_word
 
     mario = get_experiment("mario_ppo")
     assert model_name(mario, {"config": {"world": 2, "stage": 4}}) == "2-4"

@@ -6,7 +6,7 @@ import json
 import numpy as np
 import pytest
 
-from rlcore.runs.report import load_runs, summarize
+from rlcore.records.report import load_runs, summarize
 from tests.test_cli import ROOT
 
 KEPT = ROOT / "results" / "sweeps"
@@ -21,7 +21,7 @@ def test_the_kept_sweeps_are_in_the_clone():
 def test_the_readme_quotes_each_kept_sweeps_iqm_and_interval(name):
     import json
 
-    from rlcore.runs.score_words import return_digits
+    from rlcore.records.score_words import return_digits
 
     runs = load_runs(KEPT / name)
     experiment, model = name.split("__")
@@ -60,8 +60,8 @@ def readme_iqm_cell(name: str) -> str:
 def test_the_experiment_page_tells_each_kept_sweeps_collapses_as_its_evaluations_show_them(name):
     """The page's summary of collapses and keep-best (docgen's sweep-stability region) recomputed from the
     kept evals.csv files; and each seed's collapses are listed with where each fell and came back."""
-    from rlcore.runs.critic_trace import critic_cell, critic_trace
-    from rlcore.runs.eval_history import stability_summary
+    from rlcore.records.critic_trace import critic_cell, critic_trace
+    from rlcore.records.eval_history import stability_summary
     from tools.docgen.sweeps import collapses_cell
 
     experiment, model = name.split("__")
@@ -86,7 +86,7 @@ def test_the_experiment_page_tells_each_kept_sweeps_collapses_as_its_evaluations
 def test_each_kept_report_tells_the_runs_stories_as_the_code_reads_them_now(name):
     """report.md is written once by `report --keep`; when the rule that reads evals.csv changes, the kept
     reports are written again (`main.py report results/sweeps/NAME`), and this says which are stale."""
-    from rlcore.runs.report import critic_lines, stability_lines
+    from rlcore.records.report import critic_lines, stability_lines
 
     report = (KEPT / name / "report.md").read_text()
     runs = load_runs(KEPT / name)
@@ -96,7 +96,7 @@ def test_each_kept_report_tells_the_runs_stories_as_the_code_reads_them_now(name
 
 def test_a_seed_summary_gives_the_iqm_each_seed_and_the_shipped_model_beside_them():
     """The README's paragraph per kept sweep (docgen's seed-summary region), on the CartPole DQN sweep."""
-    from rlcore.runs.eval_history import stability_summary
+    from rlcore.records.eval_history import stability_summary
     from tools.docgen.sweeps import seed_summary
 
     text = seed_summary("README.md", "cartpole")

@@ -14,7 +14,7 @@ import pytest
 
 from rlcore.environments import registry
 from rlcore.files.checkpoint import read_checkpoint_state
-from rlcore.runs.report import load_runs, summarize
+from rlcore.records.report import load_runs, summarize
 from rlcore.sweeps.on_ray import run_sweep, start_ray
 from rlcore.sweeps.sweep import STOP_FILE, Sweep
 from tests.processes import alive, listening, outside_loopback, own_ray_processes

@@ -14,8 +14,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rlcore.runs.bootstrap import aggregates, probability_of_improvement, stratified_bootstrap_ci
-from rlcore.runs.report import load_runs, summarize
+from rlcore.records.bootstrap import aggregates, probability_of_improvement, stratified_bootstrap_ci
+from rlcore.records.report import load_runs, summarize
 from rlcore.sweeps.sweep import Sweep, parse_grid, parse_seeds
 from tests.processes import group_pids, listening, outside_loopback
 from tests.test_cli import run
@@ -81,7 +81,7 @@ def test_bad_sweep_values_are_one_line_and_exit_2(capsys, tmp_path, monkeypatch,
 
 
 def test_report_groups_a_grid_sweep_by_setting(tmp_path):
-    from rlcore.runs.report import markdown
+    from rlcore.records.report import markdown
 
     # skewed scores, so mean, median and IQM differ and a mix-up of their names would show
     for lr, scores in (("0.001", (137.0, 278.0, 487.0, 500.0, 500.0)), ("0.01", (600.0, 601.0, 650.0))):
@@ -159,7 +159,7 @@ def test_a_report_of_two_sweeps_leaves_each_sweeps_own_report_alone(tmp_path, ca
 
 
 def test_report_tells_each_runs_collapses_and_which_weights_its_model_holds(tmp_path):
-    from rlcore.runs.report import markdown
+    from rlcore.records.report import markdown
 
     header = "env_steps,episode,eval_mean,eval_std,eval_time_limit_share\n"
     for seed, (means, weights) in enumerate((((0.0, 15.0, 0.5, 16.0, 12.0), "best periodic evaluation"),
@@ -269,7 +269,7 @@ def test_a_goal_tasks_report_draws_the_success_share_the_stop_rule_reads(tmp_pat
     """Mario's seeds are scored by the flag: report_success.png draws metrics.csv's success_share (the share of
     the last 100 episodes from the start, what --stop-success-share reads), with the runs' stop share; a level
     x-4 ends at the axe."""
-    from rlcore.runs.report_plots import SUCCESS_SHARE, _goal, run_curve
+    from rlcore.records.report_plots import SUCCESS_SHARE, _goal, run_curve
 
     for s in range(2):
         _mario_run(tmp_path / "runs" / f"seed={s}", s, 8, stop_success_share=0.9)
@@ -449,8 +449,8 @@ def test_a_run_resumed_before_resumes_recorded_their_changes_is_not_kept():
     """Records from before 2026-11-27 list the commands but no command_starts: the resumes are there, what
     they changed is not, so the keep cannot show that they changed budgets only."""
     from rlcore.errors import UserError
-    from rlcore.runs.commands import command_starts
-    from rlcore.runs.keeping import check_one_recipe_throughout
+    from rlcore.records.commands import command_starts
+    from rlcore.records.keeping import check_one_recipe_throughout
 
     old = {"commands": ["python main.py train mario_ppo ppo --seed 0", "python main.py train mario_ppo ppo --resume R"]}
     assert command_starts(old) == [None, None]

@@ -9,10 +9,10 @@ from rlcore.files.atomic import writable_folder
 
 
 def _run_folder(run_dir: Path) -> dict:
-    """What the run in ``run_dir`` trained (:func:`rlcore.runs.status.run_record`: its model's meta.json once
+    """What the run in ``run_dir`` trained (:func:`rlcore.records.status.run_record`: its model's meta.json once
     finished, its checkpoint's state while training or resumed past its model); a folder with neither,
     or without metrics.csv, is a clear error."""
-    from rlcore.runs.status import run_record
+    from rlcore.records.status import run_record
 
     if not run_dir.is_dir():
         what = "is a file" if run_dir.exists() else "no such folder"
@@ -27,7 +27,7 @@ def _run_folder(run_dir: Path) -> dict:
 
 def cmd_plot(args) -> int:
     from rlcore.environments.registry import get_experiment
-    from rlcore.runs.plotting import plot_run
+    from rlcore.records.plotting import plot_run
 
     run_dir = Path(args.run_dir)
     about = _run_folder(run_dir)
@@ -40,7 +40,7 @@ def cmd_plot(args) -> int:
 
 def cmd_status(args) -> int:
     from rlcore.environments.registry import get_experiment
-    from rlcore.runs.status import run_status
+    from rlcore.records.status import run_status
 
     run_dir = Path(args.run_dir)
     if (run_dir / "sweep.json").is_file():  # a sweep's folder: a line per trial
@@ -99,9 +99,9 @@ def cmd_sweep(args) -> int:
 
 def cmd_report(args) -> int:
     from rlcore.host.extras import require
-    from rlcore.runs.keeping import KEPT_FILES, is_run_folder, keep, keep_runs
-    from rlcore.runs.report import markdown, summarize
-    from rlcore.runs.report_plots import SUCCESS_SHARE, plot_critic, plot_curves, plot_evals
+    from rlcore.records.keeping import KEPT_FILES, is_run_folder, keep, keep_runs
+    from rlcore.records.report import markdown, summarize
+    from rlcore.records.report_plots import SUCCESS_SHARE, plot_critic, plot_curves, plot_evals
 
     require("rliable.metrics", "The report command")  # the sweep extra, or one line saying so
     folders = [Path(d) for d in args.sweep_dirs]

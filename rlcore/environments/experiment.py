@@ -75,7 +75,7 @@ class Bar:
 
     def describe(self, success: str = "success") -> str:
         """``mean return >= 230`` or ``flag in >= 50% of episodes`` (``success``: what a successful episode
-        reaches, :func:`rlcore.runs.score_words.success_word`), for cards, tables and the console."""
+        reaches, :func:`rlcore.records.score_words.success_word`), for cards, tables and the console."""
         if self.metric == "success_share":
             text = f"{success} in >= {self.value:.0%} of episodes"
         else:

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from rlcore.errors import UserError
-from rlcore.runs.score_words import count, return_digits, score_words, success_word
+from rlcore.records.score_words import count, return_digits, score_words, success_word
 
 #: the saved_networks/ of the checkout this package runs from (``python main.py`` or an editable install)
 SAVED_NETWORKS = Path(__file__).resolve().parents[2] / "saved_networks"
@@ -62,7 +62,7 @@ def shipped_dir(experiment: str, algo: str, config=None) -> Path:
 
 def shipped_summary(folder: Path) -> str:
     """``shipped: 20.45 +- 3.99 over 30 episodes`` or ``1-1: flag in 8 of 10 episodes``, as the README
-    writes the score (:mod:`rlcore.runs.score_words`)."""
+    writes the score (:mod:`rlcore.records.score_words`)."""
     from rlcore.files.model_meta import read_meta
 
     ev = read_meta(folder).get("evaluation")

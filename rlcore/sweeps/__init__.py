@@ -1,4 +1,4 @@
 """Sweeps: one run folder per (seed, grid value) trial, on Ray Tune or one after another, their status.
 
-May import: runs, models, training and below; never api or cli.
+May import: records, models, training and below; never api or cli.
 """

@@ -7,9 +7,9 @@ import math
 from pathlib import Path
 
 from rlcore.errors import UserError
-from rlcore.runs.critic_trace import critic_cell, critic_trace
-from rlcore.runs.pace import NO_BUDGET, pace, pace_text
-from rlcore.runs.status import evaluation_lines, run_record
+from rlcore.records.critic_trace import critic_cell, critic_trace
+from rlcore.records.pace import NO_BUDGET, pace, pace_text
+from rlcore.records.status import evaluation_lines, run_record
 
 NOT_STARTED = "not started"
 

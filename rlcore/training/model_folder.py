@@ -8,7 +8,7 @@ from pathlib import Path
 from rlcore.files.atomic import writable_folder, write_atomic, write_json
 from rlcore.host.cpu import cpu_description
 from rlcore.host.machine import package_versions
-from rlcore.runs.plotting import plot_run
+from rlcore.records.plotting import plot_run
 
 
 def write_model_folder(run_dir: Path, experiment, describe: dict, save_models, record: dict) -> Path:

@@ -154,7 +154,7 @@ def run_training(spec: RunSpec, on_progress: Callable[[dict, str], None] | None 
 #: video of ``--video`` (rlcore.api's render)
 END_OF_RUN_MODULES = ("rlcore.api", "rlcore.api.models", "rlcore.files.atomic", "rlcore.files.model_meta",
                       "rlcore.training.evaluation", "rlcore.environments.gym_experiment", "rlcore.host.machine",
-                      "rlcore.networks.acting", "rlcore.networks.saving", "rlcore.runs.plotting", "rlcore.models.policies",
+                      "rlcore.networks.acting", "rlcore.networks.saving", "rlcore.records.plotting", "rlcore.models.policies",
                       "rlcore.models.shipping", "rlcore.models.snapshot", "rlcore.models.video")
 
 

@@ -36,7 +36,7 @@ def test_plot_of_an_unfinished_mario_run(capsys, tmp_path):
 
 def test_mario_plots_leave_out_restarted_episodes(capsys, tmp_path, monkeypatch):
     """Restarts start at x 2,900: their ends must not show in the endings map or the curves."""
-    import rlcore.runs.plotting as plotting
+    import rlcore.records.plotting as plotting
     rows = ["episode,total_points,av_latest_points,target_ave_scores,x_pos,success,success_share,restarted"]
     rows += [f"{i},{5 if i % 2 else 300},0,0,{3000 if i % 2 else 300 + i},0,0,{i % 2}" for i in range(1, 41)]
     write_run(tmp_path, rows)
@@ -60,7 +60,7 @@ def test_mario_plots_leave_out_restarted_episodes(capsys, tmp_path, monkeypatch)
 
 
 def test_ending_shares_say_where_each_block_of_episodes_ended():
-    from rlcore.runs.plotting import ending_shares
+    from rlcore.records.plotting import ending_shares
 
     # 10 episodes end at x 100, then 10 at x 900 (the farthest any got), then 5 split 450 / 900
     x = [100.0] * 10 + [900.0] * 10 + [450.0, 900.0, 450.0, 900.0, 450.0]
@@ -73,7 +73,7 @@ def test_ending_shares_say_where_each_block_of_episodes_ended():
 
 def test_a_plot_title_names_the_mario_level():
     from rlcore.environments.registry import get_experiment
-    from rlcore.runs.plotting import plot_title
+    from rlcore.records.plotting import plot_title
 
     about = {"algo": "ppo", "preset": "default", "seed": 0, "config": {"world": 2, "stage": 1}}
     assert plot_title(get_experiment("mario_ppo"), about) == "mario_ppo ppo 2-1 (default preset, seed 0)"
@@ -95,7 +95,7 @@ def test_a_deaths_plot_once_killed_by_is_logged(capsys, tmp_path):
 def test_cause_shares_are_the_shares_of_each_blocks_failures():
     import pandas as pd
 
-    from rlcore.runs.plotting import cause_shares
+    from rlcore.records.plotting import cause_shares
 
     causes = pd.Series([None, "fish", "pit", "fish", None, "goomba", "fish", "fish", "pit", None, None, None])
     shares = cause_shares(causes, block=3, most=2)

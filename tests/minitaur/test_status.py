@@ -33,7 +33,7 @@ def test_status_of_a_minitaur_run_shows_length_distance_and_the_last_evaluations
 
 def test_status_says_where_a_run_was_resumed_and_what_each_resume_changed(capsys, tmp_path):
     """A run meant to follow one recipe shows whether it did (meta.json's or the checkpoint's command_starts)."""
-    from rlcore.runs.status import resumes_lines
+    from rlcore.records.status import resumes_lines
 
     first = {"env_steps": 0, "episodes": 0}
     assert resumes_lines({"command_starts": [first]}) == [] and resumes_lines({}) == []
@@ -68,7 +68,7 @@ def test_status_of_a_run_in_progress_gives_its_pace_and_the_hours_left_to_its_bu
 
 
 def test_status_of_a_run_resumed_many_times_names_the_first_and_latest_resumes():
-    from rlcore.runs.status import resumes_lines
+    from rlcore.records.status import resumes_lines
 
     starts = [{"env_steps": 0, "episodes": 0}] + [
         {"env_steps": 1000 * i, "episodes": i, "changed": {"lr": [1.0 / i, 1.0 / (i + 1)]}} for i in range(1, 21)]
@@ -78,7 +78,7 @@ def test_status_of_a_run_resumed_many_times_names_the_first_and_latest_resumes()
 
 
 def test_pace_reads_only_the_rows_since_a_counter_went_back_and_never_says_nan(tmp_path):
-    from rlcore.runs.pace import pace
+    from rlcore.records.pace import pace
 
     about = {"env_steps": 3000, "config": {"max_env_steps": 6000}}
     table = tmp_path / "metrics.csv"
@@ -92,7 +92,7 @@ def test_pace_reads_only_the_rows_since_a_counter_went_back_and_never_says_nan(t
 
 
 def test_the_hours_left_are_read_from_the_pace_of_learning_not_of_the_random_first_steps(tmp_path):
-    from rlcore.runs.pace import pace
+    from rlcore.records.pace import pace
 
     about = {"env_steps": 4000, "config": {"max_env_steps": 10_000}}
     table = tmp_path / "metrics.csv"
@@ -115,7 +115,7 @@ def test_the_hours_left_are_read_from_the_pace_of_learning_not_of_the_random_fir
 def test_a_finished_run_resumed_past_its_model_is_read_from_its_checkpoint(tmp_path):
     import json
 
-    from rlcore.runs.status import run_record
+    from rlcore.records.status import run_record
 
     assert run_record(tmp_path) is None
     (tmp_path / "model").mkdir()
@@ -151,7 +151,7 @@ def test_the_sweeps_hours_left_are_never_fewer_than_its_longest_trials():
 def test_an_episode_budget_gives_the_hours_left_too(tmp_path):
     """Issue 65: status gave the hours left only for an env-step budget. 10 episodes of 100 steps in 100 s
     (0.1 episode/s): 90 of a 100-episode budget left is 900 s; with both budgets, the one met first."""
-    from rlcore.runs.pace import pace, pace_text
+    from rlcore.records.pace import pace, pace_text
 
     table = tmp_path / "metrics.csv"
     table.write_text("episode,env_steps,wall_seconds\n" + "".join(f"{i},{100 * i},{10 * i}\n" for i in range(1, 11)))

@@ -107,8 +107,8 @@ def test_the_check_finds_a_cycle_hidden_in_a_function(tmp_path):
 
 
 def test_every_folder_of_code_is_a_package_the_wheel_finds():
-    """setup.cfg's `packages = find:` takes only folders with an __init__.py: one without (rlcore/runs/ was
-    ignored by a `runs/` line meant for the top-level run folders) would be left out of a wheel."""
+    """setup.cfg's `packages = find:` takes only folders with an __init__.py: one without (rlcore/runs/, now records/,
+    was once ignored by a `runs/` line meant for the top-level run folders) would be left out of a wheel."""
     from setuptools import find_packages
 
     found = set(find_packages(str(ROOT), include=["rlcore", "rlcore.*"]))

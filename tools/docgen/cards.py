@@ -5,7 +5,7 @@ import json
 from rlcore.algorithms.registry import FAMILIES
 from rlcore.environments.registry import experiment_names, get_experiment
 from rlcore.hyperparams.flags import to_dict
-from rlcore.runs.score_words import hours, score_words
+from rlcore.records.score_words import hours, score_words
 from tools.docgen.data import REPO
 from tools.docgen.reference import region_bars
 from tools.docgen.regions import OVER_SEEDS_HEADER, experiment_page, region_shipped, region_sweeps
@@ -24,7 +24,7 @@ from tools.docgen.words import (
 )
 
 #: what a model folder's file is, by its name or extension, or a plot by its kind (PREFIX_KIND_ALGO.png, as
-#: rlcore/runs/plotting.py names it)
+#: rlcore/records/plotting.py names it)
 FILE_ROLES = {".h5": "Keras model (the whole network, loadable on its own)", "meta.json":
               "what the run was: preset, every hyperparameter, commands, counters, versions, evaluation",
               "metrics.csv": "one row per training episode", "evals.csv": "the periodic evaluations on selection seeds",

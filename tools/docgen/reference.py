@@ -8,7 +8,7 @@ from collections import Counter
 
 from rlcore.environments.registry import experiment_names, get_experiment
 from rlcore.hyperparams.allowed import field_words
-from rlcore.runs.score_words import success_word
+from rlcore.records.score_words import success_word
 from tools.docgen.data import REPO, shipped_models
 from tools.docgen.words import fill, link, table
 

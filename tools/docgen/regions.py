@@ -3,8 +3,8 @@ and ``<!-- /generated -->`` is region NAME with ARG (:data:`REGIONS`); the rest 
 The regions about the shipped models are here; the others in :mod:`.reference` and :mod:`.sweeps`."""
 import re
 
-from rlcore.runs.commands import cpus_text
-from rlcore.runs.score_words import hours, success_word
+from rlcore.records.commands import cpus_text
+from rlcore.records.score_words import hours, success_word
 from tools.docgen import reference, sweeps
 from tools.docgen.data import REPO, shipped_models
 from tools.docgen.words import (

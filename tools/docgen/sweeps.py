@@ -3,10 +3,10 @@
 weights than the last), ``seed-runs`` (each seed's scores, env steps, wall time and speed) and
 ``seed-summary`` (one paragraph per sweep for the README)."""
 from rlcore.environments.registry import get_experiment
-from rlcore.runs.commands import cpus_text
-from rlcore.runs.critic_trace import WINDOW, critic_cell, critic_trace
-from rlcore.runs.eval_history import stability_summary, steps_text, story
-from rlcore.runs.score_words import hours, score_words, stop_words
+from rlcore.records.commands import cpus_text
+from rlcore.records.critic_trace import WINDOW, critic_cell, critic_trace
+from rlcore.records.eval_history import stability_summary, steps_text, story
+from rlcore.records.score_words import hours, score_words, stop_words
 from tools.docgen import data  # its REPO and shipped_models read at each call (tests point them elsewhere)
 from tools.docgen.words import fill, link, over_seeds, score_text, sweep_score, table
 
@@ -117,7 +117,7 @@ def evaluation_cell(evaluation: dict, m) -> str:
 
 
 def stop_text(meta: dict, m) -> str:
-    """What ended the run of ``meta``, a run of model ``m``, in words (:func:`rlcore.runs.score_words.stop_words`)."""
+    """What ended the run of ``meta``, a run of model ``m``, in words (:func:`rlcore.records.score_words.stop_words`)."""
     return stop_words(meta.get("stopped_by") or "", m.experiment, m.name, (meta.get("config") or {}).get("window", 100))
 
 

@@ -6,7 +6,7 @@ from pathlib import Path
 from string import Template
 
 from rlcore.environments.registry import get_experiment
-from rlcore.runs.score_words import return_digits, score_words, success_word
+from rlcore.records.score_words import return_digits, score_words, success_word
 
 TEMPLATES = Path(__file__).parent / "templates"
 #: where one registry entry covers two articles, which algorithm comes from which

@@ -1,8 +1,8 @@
-"""Collapses and kept weights read back from a run's periodic evaluations (rlcore.runs.eval_history)."""
+"""Collapses and kept weights read back from a run's periodic evaluations (rlcore.records.eval_history)."""
 import pytest
 
 from rlcore.errors import UserError
-from rlcore.runs.eval_history import (
+from rlcore.records.eval_history import (
     Evaluation,
     Story,
     collapses,
@@ -136,7 +136,7 @@ def test_the_story_and_the_summary_say_which_runs_had_nothing_to_lose(tmp_path):
 
 
 def test_a_report_knows_the_solved_score_from_the_record_or_the_registry_and_else_claims_nothing():
-    from rlcore.runs.report import _solved_score
+    from rlcore.records.report import _solved_score
 
     assert _solved_score({"experiment": "minitaur"}) == 15.0
     assert _solved_score({"experiment": "Acrobot-v1", "env": {"reward_threshold": -100}}) == -100.0

@@ -1,7 +1,7 @@
 """``main.py status RUN_DIR``: where a run stands, in a few lines, from its CSV tables.
 
 First what the run is and how far it got, with the pace of a run in progress and the hours left at that
-pace to its env-step budget (:mod:`rlcore.runs.pace`), and where it was resumed and what each resume changed
+pace to its env-step budget (:mod:`rlcore.records.pace`), and where it was resumed and what each resume changed
 (:func:`resumes_lines`), and where a success-share stop rule stands (:func:`goal_line`). Then, for a run that lasts many sessions (a Mario level): per block of
 episodes that started where evaluations start, the success share, the mean progress and the mean
 return; the episodes that started elsewhere (Mario's restarts) beside them, with where they started;
@@ -20,11 +20,11 @@ import numpy as np
 import pandas as pd
 
 from rlcore.files.model_meta import read_json
-from rlcore.training.evaluation import count_causes
-from rlcore.runs.plotting import full_episodes, read_table
-from rlcore.runs.pace import pace_text
-from rlcore.runs.score_words import hours, stop_words
 from rlcore.models.shipping import model_name
+from rlcore.records.pace import pace_text
+from rlcore.records.plotting import full_episodes, read_table
+from rlcore.records.score_words import hours, stop_words
+from rlcore.training.evaluation import count_causes
 
 
 def run_status(run_dir: str | Path, experiment, about: dict, block: int = 200,
@@ -82,7 +82,7 @@ def resumes_lines(about: dict, most: int = 6) -> list[str]:
     follow one recipe shows that it did: none for a run never resumed; of many, the first and the
     ``most`` latest."""
     from rlcore.hyperparams.flags import change_text
-    from rlcore.runs.commands import command_starts
+    from rlcore.records.commands import command_starts
 
     resumes = command_starts(about)[1:]
     if not resumes:
@@ -138,8 +138,8 @@ def block_line(experiment, part: pd.DataFrame, partial: pd.DataFrame | None) -> 
     words.append(f"mean return {part['total_points'].mean():.1f}")
     if "episode_steps" in part:  # SAC: how long it stood (a Minitaur fall ends it early)
         words.append(f"mean length {part['episode_steps'].mean():,.0f} steps")
-    if "q_mean" in part and part["q_mean"].notna().any():  # a Q-learner's critic (rlcore/runs/critic_trace.py)
-        from rlcore.runs.critic_trace import q_text
+    if "q_mean" in part and part["q_mean"].notna().any():  # a Q-learner's critic (rlcore/records/critic_trace.py)
+        from rlcore.records.critic_trace import q_text
 
         words.append(f"median Q {q_text(part['q_mean'].median())}")
     if not success_key:  # Minitaur: x, the metres walked

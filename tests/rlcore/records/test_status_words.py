@@ -3,7 +3,7 @@ wall time in seconds (a 393 s run read '0.1 h', a 122 s one '0.0 h')."""
 from __future__ import annotations
 
 from rlcore.environments.registry import get_experiment
-from rlcore.runs.status import headline
+from rlcore.records.status import headline
 
 
 def test_a_finished_runs_headline_says_what_stopped_it_in_words():
@@ -21,7 +21,7 @@ def test_a_finished_runs_headline_says_what_stopped_it_in_words():
 def test_rollouts_of_a_task_without_a_success_event_give_no_success_share(tmp_path):
     """PPO on CartPole-v1 logs rollouts.csv too; its blocks said 'success 0/1024' of a goal it has none of."""
     from rlcore.environments.gym_experiment import gym_experiment
-    from rlcore.runs.status import rollout_lines
+    from rlcore.records.status import rollout_lines
 
     rows = ["rollout,env_steps,episodes_ended,successes,entropy"] + [f"{r},{512 * r},{20 + r},0,0.6" for r in (1, 2)]
     (tmp_path / "rollouts.csv").write_text("\n".join(rows) + "\n")
@@ -30,7 +30,7 @@ def test_rollouts_of_a_task_without_a_success_event_give_no_success_share(tmp_pa
 
 
 def test_a_run_resumed_on_another_cpu_names_each_with_where_it_took_over():
-    from rlcore.runs.commands import cpus_text
+    from rlcore.records.commands import cpus_text
 
     epyc, xeon = "AMD EPYC (avx2 avx512_bf16)", "Intel Xeon (avx2 avx512f)"
     starts = [{"env_steps": 0, "cpu": epyc}, {"env_steps": 286_720, "cpu": epyc}, {"env_steps": 614_400, "cpu": xeon}]
@@ -49,7 +49,7 @@ def test_the_hours_left_to_a_budget_say_a_stop_rule_may_end_the_run_sooner():
     budget are an upper bound, and the line says so."""
     from pathlib import Path
 
-    from rlcore.runs.pace import Pace, pace_text
+    from rlcore.records.pace import Pace, pace_text
 
     measured = Pace(53.0, 25.5 * 3600, "6,000,000 env steps")
     text = pace_text(Path("unread.csv"), {"config": {"max_env_steps": 6_000_000, "stop_success_share": 0.9}}, measured)

@@ -8,10 +8,10 @@ import json
 import shutil
 from pathlib import Path
 
-from rlcore.files.model_meta import read_json
 from rlcore.errors import UserError
-from rlcore.runs.report import load_runs
-from rlcore.runs.commands import command_starts
+from rlcore.files.model_meta import read_json
+from rlcore.records.commands import command_starts
+from rlcore.records.report import load_runs
 
 #: what ``keep`` copies of a run folder: what the report reads (meta.json, metrics.csv), the periodic
 #: evaluations (evals.csv), PPO's rollout table (rollouts.csv) and the model's weights (model/*.h5), so

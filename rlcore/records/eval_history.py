@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from rlcore.errors import UserError
-from rlcore.runs.score_words import count
+from rlcore.records.score_words import count
 
 DROP, RECOVER, LEARNT, LEAST = 0.25, 0.75, 0.5, 0.25
 

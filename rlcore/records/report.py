@@ -1,6 +1,6 @@
 """``main.py report``: per-run results of one or more sweeps, aggregated with confidence intervals
-(mean, median and IQM with 95 % stratified bootstrap intervals, as rliable has them: :mod:`rlcore.runs.bootstrap`),
-and what each run's periodic evaluations and critic saw. Keeping runs in ``results/``: :mod:`rlcore.runs.keeping`.
+(mean, median and IQM with 95 % stratified bootstrap intervals, as rliable has them: :mod:`rlcore.records.bootstrap`),
+and what each run's periodic evaluations and critic saw. Keeping runs in ``results/``: :mod:`rlcore.records.keeping`.
 
 A run's final score is the evaluation on unseen seeds in its ``model/meta.json``: the greedy mean
 return, or for Mario the share of episodes that reached the flag. TensorFlow-free.
@@ -11,12 +11,12 @@ from pathlib import Path
 
 import numpy as np
 
-from rlcore.files.model_meta import read_json
-from rlcore.runs.bootstrap import AGGREGATES, aggregates, probability_of_improvement, stratified_bootstrap_ci
 from rlcore.errors import UserError
-from rlcore.runs.eval_history import stability_summary, story, story_text
-from rlcore.runs.commands import cpus_text
-from rlcore.runs.score_words import count
+from rlcore.files.model_meta import read_json
+from rlcore.records.bootstrap import AGGREGATES, aggregates, probability_of_improvement, stratified_bootstrap_ci
+from rlcore.records.commands import cpus_text
+from rlcore.records.eval_history import stability_summary, story, story_text
+from rlcore.records.score_words import count
 
 
 def load_runs(sweep_dir: Path) -> list[dict]:
@@ -60,8 +60,8 @@ def _goal_word(meta: dict) -> str:
     """What a run's successful episodes reach (Mario: flag, or axe on x-4), as the cards say it: the model's
     name read from its config as its shipped folder would have it (:func:`rlcore.models.shipping.model_name`)."""
     from rlcore.environments.registry import get_experiment
-    from rlcore.runs.score_words import success_word
     from rlcore.models.shipping import model_name
+    from rlcore.records.score_words import success_word
 
     exp = get_experiment(meta["experiment"])
     return success_word(exp.name, model_name(exp, meta), other="goal")
@@ -70,7 +70,7 @@ def _goal_word(meta: dict) -> str:
 def _solved_score(meta: dict) -> float | None:
     """The solved score of the task a run's meta.json names: a Gymnasium id's recorded
     ``reward_threshold``, else the registry's. None where it has none or it cannot be known here (then
-    nothing is claimed, :func:`rlcore.runs.eval_history.far_from_solved`): a report never needs the env itself."""
+    nothing is claimed, :func:`rlcore.records.eval_history.far_from_solved`): a report never needs the env itself."""
     from rlcore.environments.registry import EXPERIMENT_MODULES, get_experiment
 
     env = meta.get("env")
@@ -156,7 +156,7 @@ def _of(run: dict) -> str:
 
 def stability_lines(runs: list[dict]) -> list[str]:
     """What the runs' periodic evaluations (on selection seeds) say: collapses and the weights kept
-    (:mod:`rlcore.runs.eval_history` defines a collapse)."""
+    (:mod:`rlcore.records.eval_history` defines a collapse)."""
     stories = [r["story"] for r in runs]
     if not any(st.evaluations for st in stories):
         return ["No periodic evaluations: each model holds its run's last weights."]
@@ -166,9 +166,9 @@ def stability_lines(runs: list[dict]) -> list[str]:
 
 
 def critic_lines(runs: list[dict]) -> list[str]:
-    """Each run's critic at its end beside the largest return it was paid (:mod:`rlcore.runs.critic_trace`);
+    """Each run's critic at its end beside the largest return it was paid (:mod:`rlcore.records.critic_trace`);
     nothing for runs that log no Q."""
-    from rlcore.runs.critic_trace import WINDOW, critic_cell, critic_trace
+    from rlcore.records.critic_trace import WINDOW, critic_cell, critic_trace
 
     traces = [critic_trace(r["run_dir"]) for r in runs]
     if all(t is None for t in traces):

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from rlcore.runs.report_plots import _iqm_band
+from rlcore.records.report_plots import _iqm_band
 
 metrics = pytest.importorskip("rliable.metrics")
 

@@ -9,8 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from rlcore.host.extras import require
-from rlcore.runs.score_words import count
-
+from rlcore.records.score_words import count
 
 #: metrics.csv's columns a report draws over env steps: the 100-episode average return, and for a task with a
 #: goal (Mario's flag) the share of the last 100 episodes from the start that reached it (the stop rule's)
@@ -129,7 +128,7 @@ def plot_evals(result: dict, out: Path, reps: int = 1000) -> Path | None:
     sweeps = [s for s in result["sweeps"] if all(r["story"].evaluations for r in s["runs"])]
     if not sweeps:
         return None
-    from rlcore.runs.eval_history import read_evals
+    from rlcore.records.eval_history import read_evals
 
     fig, ax = _figure()
     for s in sweeps:
@@ -150,10 +149,10 @@ def plot_evals(result: dict, out: Path, reps: int = 1000) -> Path | None:
 
 
 def plot_critic(result: dict, out: Path) -> Path | None:
-    """Each run's mean Q over env steps (the running median of :func:`rlcore.runs.critic_trace.critic_trace`),
+    """Each run's mean Q over env steps (the running median of :func:`rlcore.records.critic_trace.critic_trace`),
     one line per run that logs Q, on a log scale (linear within +-1, where Q may change sign), so a critic
     that diverges stands out by orders of magnitude. ``None`` (no file) when no run logs Q (A2C, PPO)."""
-    from rlcore.runs.critic_trace import WINDOW, critic_trace
+    from rlcore.records.critic_trace import WINDOW, critic_trace
 
     lines = [(f"{s['label']} {r['trial']}" if len(result["sweeps"]) > 1 else r["trial"], critic_trace(r["run_dir"]))
              for s in result["sweeps"] for r in s["runs"]]

@@ -5,7 +5,7 @@ A critic estimates discounted returns, so its mean Q stays within the scale of t
 seen; a critic that diverges does not (seed 2 of the Minitaur sweep: its mean Q rose from 0.2 at 160k env
 steps to about 3,000 at 1M, while no training episode returned more than 5.6). Nothing here draws a
 line between the two: the report and the docs print both numbers side by side and
-:func:`rlcore.runs.report_plots.plot_critic` draws the curve. The comparison holds at a run's end, not at its
+:func:`rlcore.records.report_plots.plot_critic` draws the curve. The comparison holds at a run's end, not at its
 start: SAC's Q is soft (it holds the entropy bonus), so its first ~20k steps read high (about 54 against
 returns of about 3 on Minitaur) while the temperature is still near its initial 1. TensorFlow-free.
 """

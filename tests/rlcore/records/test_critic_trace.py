@@ -1,4 +1,4 @@
-"""A run's critic read back from metrics.csv (rlcore/runs/critic_trace.py): the running median against a direct
+"""A run's critic read back from metrics.csv (rlcore/records/critic_trace.py): the running median against a direct
 computation, episodes without gradient steps left out, runs without a critic's Q, and what `report` writes
 of a sweep whose one critic diverged."""
 import json
@@ -6,7 +6,7 @@ import json
 import numpy as np
 import pytest
 
-from rlcore.runs.critic_trace import critic_cell, critic_trace, running_median
+from rlcore.records.critic_trace import critic_cell, critic_trace, running_median
 from tests.test_cli import run
 
 HEADER = "episode,total_points,av_latest_points,target_ave_scores,env_steps,wall_seconds,critic_loss,q_mean\n"

@@ -9,8 +9,7 @@ from typing import NamedTuple
 import numpy as np
 import pandas as pd
 
-from rlcore.runs.plotting import read_table
-
+from rlcore.records.plotting import read_table
 
 #: a budget this large is no budget (the presets' "until the stop rule" values)
 NO_BUDGET = 10**9
