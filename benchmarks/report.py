@@ -43,7 +43,7 @@ def main() -> None:
     import numpy as np
 
     from rlcore.cli.main import main as cli_main
-    from rlcore.runs.report_plots import _iqm_band
+    from rlcore.records.report_plots import _iqm_band
 
     def report() -> None:
         with tempfile.TemporaryDirectory() as out, contextlib.redirect_stdout(io.StringIO()):
