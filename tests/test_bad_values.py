@@ -460,6 +460,28 @@ def test_publish_refusal_reads_the_bar_of_the_folder_it_would_replace():
     assert "2-2 (flag in >= 90% of episodes)" in publish_refusal(mario, Path("saved/mario_ppo/2-2"), flags)
 
 
+def test_a_run_that_spent_its_presets_budget_replaces_a_model_below_its_bar_and_no_other():
+    """Issue 63: a Mario level whose run from one command misses the bar within the budget its preset set before
+    the run ships that run, in place of the old model below its bar; never a run cut short, or with its budget
+    changed, or over a model that meets its bar."""
+    from dataclasses import replace
+
+    from rlcore.environments.registry import get_experiment
+    from rlcore.models.shipping import publish_refusal
+
+    mario = get_experiment("mario_ppo")
+    budget = mario.preset("ppo", "flag").max_env_steps
+    spent = {"algo": "ppo", "preset": "flag", "config": {"max_env_steps": budget}, "stopped_by": f"max_env_steps {budget}",
+             "evaluation": {"success_share": 26 / 30, "episodes": 30}}
+    assert "1-1" in mario.below_bar
+    assert publish_refusal(mario, Path("saved/mario_ppo/1-1"), spent) is None
+    short = {**spent, "config": {"max_env_steps": budget // 2}, "stopped_by": f"max_env_steps {budget // 2}"}
+    for meta in (short, {**spent, "stopped_by": "interrupted"}, {**spent, "preset": "no-such-preset"}):
+        assert "misses the bar of the shipped 1-1" in publish_refusal(mario, Path("saved/mario_ppo/1-1"), meta)
+    met = replace(mario, below_bar={})  # the level's model meets its bar: nothing below it replaces it
+    assert "misses the bar of the shipped 1-1" in publish_refusal(met, Path("saved/mario_ppo/1-1"), spent)
+
+
 def test_a_folder_that_takes_no_new_files_is_said_so_not_missing():
     """/proc is there, but a file cannot be made in it: the OS says "No such file or directory", which read as
     if the folder were missing (a new user's `render ... --out /proc/x.mp4`)."""

@@ -98,6 +98,9 @@ def cmd_train(args) -> int:
             raise UserError(f"not published to {target}/: {why}; the model stays in {model_dir}/")
         shipping.publish(model_dir, target)
         print(f"published to {target}/")
+        if (bar := spec.experiment.bar(target.name)) and not bar.met_by(meta["evaluation"]):  # it spent its budget
+            print(f"it ships short of its bar, having spent its budget: write where it stalls into the registry's "
+                  f"below_bar reason for {target.name}, which its card gives")
     return 0
 
 
