@@ -356,7 +356,7 @@ def test_a_model_published_over_another_records_what_it_replaced_and_its_card_sa
     import json
 
     from rlcore.models.shipping import publish
-    from tools.docgen.cards import replaced_text
+    from tools.docgen.main import replaced_text
 
     model, target = tmp_path / "run" / "model", tmp_path / "saved" / "1-2"
     model.mkdir(parents=True)

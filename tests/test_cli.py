@@ -188,7 +188,7 @@ def test_list_and_help(capsys):
 def test_list_writes_each_shipped_score_as_the_readme_does(capsys):
     """`list` and the README's results table read the same meta.json: the same words and digits."""
     from tools.docgen.data import shipped_models
-    from tools.docgen.words import score_text
+    from tools.docgen.main import score_text
 
     code, out, _ = run(capsys, "list")
     readme = (Path(main.__file__).parent / "README.md").read_text()

@@ -62,7 +62,7 @@ def test_the_experiment_page_tells_each_kept_sweeps_collapses_as_its_evaluations
     kept evals.csv files; and each seed's collapses are listed with where each fell and came back."""
     from rlcore.records.critic_trace import critic_cell, critic_trace
     from rlcore.records.eval_history import stability_summary
-    from tools.docgen.sweeps import collapses_cell
+    from tools.docgen.main import collapses_cell
 
     experiment, model = name.split("__")
     page = (ROOT / "docs" / "experiments" / f"{experiment}.md").read_text()
@@ -97,9 +97,9 @@ def test_each_kept_report_tells_the_runs_stories_as_the_code_reads_them_now(name
 def test_a_seed_summary_gives_the_iqm_each_seed_and_the_shipped_model_beside_them():
     """The README's paragraph per kept sweep (docgen's seed-summary region), on the CartPole DQN sweep."""
     from rlcore.records.eval_history import stability_summary
-    from tools.docgen.sweeps import seed_summary
+    from tools.docgen.main import render
 
-    text = seed_summary("README.md", "cartpole")
+    text = render("regions/seed-summary.md", page="README.md", arg="cartpole")
     runs = load_runs(KEPT / "cartpole__dqn")
     iqm, lo, hi = summarize([KEPT / "cartpole__dqn"], reps=5000)["sweeps"][0]["aggregates"]["iqm"]
     first = text.split("\n\n")[0]
@@ -108,7 +108,7 @@ def test_a_seed_summary_gives_the_iqm_each_seed_and_the_shipped_model_beside_the
                                    f"{r['wall_seconds']:.0f} s" for r in runs) in first
     assert "the shipped model (seed 0, a run of its own) 500.0" in first
     assert first.endswith(stability_summary([r["story"] for r in runs]))
-    assert "Not kept" in seed_summary("README.md", "no_such_experiment")
+    assert "Not kept" in render("regions/seed-summary.md", page="README.md", arg="no_such_experiment")
 
 
 def kept_models() -> list[str]:
@@ -148,7 +148,7 @@ def test_a_kept_runs_model_plays_its_recorded_first_episode_again(run):
 def test_what_ended_a_run_is_said_in_words_and_an_unknown_rule_as_recorded():
     from types import SimpleNamespace
 
-    from tools.docgen.sweeps import stop_text
+    from tools.docgen.main import stop_text
 
     mario = SimpleNamespace(experiment="mario_ppo", name="1-1")
     said = {"max_env_steps 1000000": "its budget of 1,000,000 env steps",
@@ -167,7 +167,7 @@ def test_a_seeds_score_gives_its_full_length_share_where_the_bar_asks_for_one():
     from types import SimpleNamespace
 
     from rlcore.environments.registry import get_experiment
-    from tools.docgen.sweeps import evaluation_cell
+    from tools.docgen.main import evaluation_cell
 
     minitaur = SimpleNamespace(experiment="minitaur", name="sac", bar=get_experiment("minitaur").bar("sac"),
                                evaluation={"mean": 20.45})  # the shipped model's: two decimals
@@ -186,7 +186,7 @@ def test_a_headline_recipe_is_held_to_its_bar_over_seeds_and_the_summary_says_wh
     from types import SimpleNamespace
 
     from rlcore.environments.registry import get_experiment
-    from tools.docgen.sweeps import seeds_bar_text
+    from tools.docgen.main import seeds_bar_text
 
     minitaur = get_experiment("minitaur").bar("sac").over_seeds
     mario = get_experiment("mario_ppo").bar("1-1").over_seeds

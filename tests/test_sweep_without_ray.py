@@ -211,8 +211,7 @@ def test_single_runs_over_seeds_are_kept_and_reported_as_a_sweep_of_their_level(
     given again on a resume may differ), and the docs generator finds them as the sweep of level 1-1."""
     # imported before docgen_data.REPO points at tmp_path below: a module imported while it does would keep it
     from tools.docgen import data as docgen_data
-    from tools.docgen import regions as docgen  # noqa: F401
-    from tools.docgen import sweeps as docgen_sweeps
+    from tools.docgen import main as docgen
 
     budget_again = ({"max_env_steps": [10**7, 2 * 10**7]}, {})  # seed 1 resumed twice: a new budget, then nothing
     runs = [str(_mario_run(tmp_path / "long_runs" / f"1-1-seed-{s}", s, flags, further, resumes, max_env_steps=budget))
@@ -242,25 +241,24 @@ def test_single_runs_over_seeds_are_kept_and_reported_as_a_sweep_of_their_level(
                                 {"algo": "ppo", "seed": 0, "evaluation": {"episodes": 10, "success_share": 0.8}},
                                 get_experiment("mario_ppo").bar("1-1"), found[("mario_ppo", "1-1")])
     monkeypatch.setattr(docgen_data, "shipped_models", lambda: [shipped])
-    summary = docgen_sweeps.seed_summary("README.md", "mario_ppo")
+    summary = docgen.render("regions/seed-summary.md", page="README.md", arg="mario_ppo")
     assert ("per seed 0: flag in 9 of 10 after 1,000 env steps, 10 s; 1: flag in 10 of 10 after 2,000 env steps, 10 s; "
             "2: flag in 6 of 10 after 3,000 env steps, 10 s; the shipped model (seed 0, a run of its own) flag in 8 of "
             "10.") in summary and "During training" not in summary
     assert "Bar over seeds: median over 3 seeds >= 80%, every seed >= 50% (" in summary and summary.endswith("): **met**.")
-    assert "its runs made no periodic evaluations" in docgen_sweeps.sweep_stability("docs/x.md", "mario_ppo")
-    rows = docgen_sweeps.seed_runs("docs/x.md", "mario_ppo")
+    stability = docgen.render("regions/sweep-stability.md", page="docs/x.md", arg="mario_ppo")
+    assert "its runs made no periodic evaluations" in stability
+    rows = docgen.render("regions/seed-runs.md", page="docs/x.md", arg="mario_ppo")
     assert "| 0 | flag in 9 of 10 | flag in 27 of 30 (1000010..1000039) | 1,000 | 10 s | 100 | not recorded | – |" in rows
     assert "| 1 | flag in 10 of 10 | – |" in rows
     for seed in range(3):  # one rule ended every run: said once below the table, not in every row
         meta_path = kept / f"seed={seed}" / "model" / "meta.json"
         meta_path.write_text(json.dumps({**json.loads(meta_path.read_text()), "stopped_by": "stop_success_share 0.9"}))
-    rows = docgen_sweeps.seed_runs("docs/x.md", "mario_ppo")
+    rows = docgen.render("regions/seed-runs.md", page="docs/x.md", arg="mario_ppo")
     assert "| 0 | flag in 9 of 10 | flag in 27 of 30 (1000010..1000039) | 1,000 | 10 s | 100 | not recorded |\n" in rows
     assert "stopped by" not in rows.split("Every run")[0] and ("Every run was stopped by the flag reached in 90% or "
                                                                "more of the last 100") in rows
-    monkeypatch.setattr(docgen, "shipped_models", lambda: [shipped])
-    monkeypatch.setattr(docgen, "REPO", tmp_path)
-    curves = docgen.region_curves("docs/experiments/mario_ppo.md", "mario_ppo")
+    curves = docgen.render("regions/curves.md", page="docs/experiments/mario_ppo.md", arg="mario_ppo")
     assert ("1-1, 3 seeds: the share of the last 100 episodes that reached the flag, as the stop rule reads it"
             in curves and "results/sweeps/mario_ppo__1-1/report_success.png)" in curves)
 

@@ -3,8 +3,7 @@ what the whole chain cost, and the CSV columns are those of every shipped file, 
 from __future__ import annotations
 
 from tools.docgen import data as docgen_data
-from tools.docgen import reference as docgen_reference
-from tools.docgen import regions as docgen
+from tools.docgen import main as docgen
 
 
 def _model(tmp_path, name, meta, header=None):
@@ -26,23 +25,22 @@ def test_a_chain_of_init_from_runs_is_added_up_and_named(tmp_path, monkeypatch):
     alone = _model(tmp_path, "1-2", {"env_steps": 70, "wall_seconds": 36.0})
     assert [p["path"] for p in chained.lineage] == ["saved_networks/mario_ppo/2-3", "saved_networks/mario_ppo/2-1"]
     assert chained.from_scratch() == (1_500, 7_200.0) and alone.lineage == [] and alone.from_scratch() == (70, 36.0)
-    monkeypatch.setattr(docgen, "shipped_models", lambda: [chained, again, alone])
-    monkeypatch.setattr(docgen, "card_path", lambda m, page: f"{m.name}.md")
-    text = docgen.region_shipped("docs/x.md", "mario_ppo")
+    monkeypatch.setattr(docgen_data, "shipped_models", lambda: [chained, again, alone])
+    text = docgen.render("regions/shipped.md", page="docs/x.md", arg="mario_ppo")
     assert "| 300 | 10 | 1,800 s | 1,500, 2.0 h (from 2-3, 2-1) |" in text
     assert "| 50 | 10 | 360 s | 100, 720 s (from an earlier 2-2) |" in text
     assert "| 70 | 10 | 36 s | – |" in text
-    monkeypatch.setattr(docgen, "shipped_models", lambda: [alone])  # no chain: no column
-    assert "started from" not in docgen.region_shipped("docs/x.md", "mario_ppo")
+    monkeypatch.setattr(docgen_data, "shipped_models", lambda: [alone])  # no chain: no column
+    assert "started from" not in docgen.render("regions/shipped.md", page="docs/x.md", arg="mario_ppo")
 
 
 def test_csv_columns_are_those_of_every_file(tmp_path, monkeypatch):
     old = _model(tmp_path, "1-2", {}, "rollout,env_steps,loss")
     new = _model(tmp_path, "1-1", {}, "rollout,env_steps,loss,lr")
-    monkeypatch.setattr(docgen_reference, "REPO", tmp_path)
-    monkeypatch.setattr(docgen_reference, "shipped_models", lambda: [old, new])
-    text = docgen_reference.region_csv_columns("docs/x.md", "mario_ppo")
+    monkeypatch.setattr(docgen_data, "REPO", tmp_path)
+    monkeypatch.setattr(docgen_data, "shipped_models", lambda: [old, new])
+    text = docgen.render("regions/csv-columns.md", page="docs/x.md", arg="mario_ppo")
     assert "| `rollouts.csv` | mario_ppo | ppo | `rollout`, `env_steps`, `loss`, `lr`* |" in text
     assert "in some of the shipped models' files only" in text
-    monkeypatch.setattr(docgen_reference, "shipped_models", lambda: [new])
-    assert "*" not in docgen_reference.region_csv_columns("docs/x.md", "mario_ppo").replace("`", "")
+    monkeypatch.setattr(docgen_data, "shipped_models", lambda: [new])
+    assert "*" not in docgen.render("regions/csv-columns.md", page="docs/x.md", arg="mario_ppo").replace("`", "")

@@ -1,13 +1,20 @@
-"""What the docs generator reads: the shipped models (``saved_networks/*/*/meta.json``) and the sweeps
-kept in ``results/sweeps/``, as :class:`Model` and :class:`Sweep` records. TensorFlow-free."""
+"""What the docs generator reads: the shipped models (``saved_networks/*/*/meta.json``), the sweeps kept in
+``results/sweeps/`` and their runs, the CSV headers and the registry's presets. TensorFlow-free."""
+import argparse
+import dataclasses
+import functools
 import json
 import re
-from dataclasses import dataclass
 from pathlib import Path
 
+from rlcore.algorithms.registry import FAMILIES
+from rlcore.cli.parser import build_parser
 from rlcore.environments.experiment import Bar
 from rlcore.environments.registry import experiment_names, get_experiment
 from rlcore.files.model_meta import cost_from_scratch, lineage
+from rlcore.hyperparams.allowed import field_words
+from rlcore.hyperparams.flags import to_dict
+from rlcore.records.eval_history import story
 
 REPO = Path(__file__).resolve().parents[2]
 #: the Gymnasium id each experiment's models play (Mario's depends on the level)
@@ -17,9 +24,12 @@ ENV_IDS = {"lunar_lander": "LunarLander-v3", "cartpole": "CartPole-v1", "cartpol
 # ..., where a goal's share gives the episodes behind it: 0.800 (8 of 10))
 AGGREGATE_ROW = re.compile(r"^\| (mean|median|iqm) \| (-?[\d.]+) \| \[(-?[\d.]+), (-?[\d.]+)\] \|$")
 RUN_ROW = re.compile(r"^\| [^|]+ \| \d+ \| (-?[\d.]+)(?: \(\d+ of \d+\))? \|", re.M)
+#: where one registry entry covers two articles, which algorithm comes from which
+ARTICLE_OF_ALGO = {(exp, algo): article for exp in ("cartpole", "cartpole_v0")
+                   for algo, article in (("dqn", "003"), ("a2c", "002"))}
 
 
-@dataclass
+@dataclasses.dataclass
 class Sweep:
     """A kept sweep (results/sweeps/NAME) of one shipped model's recipe over seeds."""
     folder: str  # repo-relative
@@ -30,7 +40,7 @@ class Sweep:
         self.report = f"{self.folder}/report.md"
 
 
-@dataclass
+@dataclasses.dataclass
 class Model:
     """One shipped model folder, with the names and places the docs give it."""
     experiment: str
@@ -47,20 +57,26 @@ class Model:
         self.env_id = ENV_IDS.get(self.experiment, self.experiment).format(model=self.name)
         gif = f"docs/assets/gifs/{self.slug}.gif"  # written by `make gifs`
         self.gif = gif if (REPO / gif).is_file() else None
-
-    @property
-    def algo_name(self) -> str:
-        """The algorithm's short name in the registry: ``Dueling DDQN``."""
-        return get_experiment(self.experiment).algos[self.algo].description.split(",")[0]
-
-    @property
-    def lineage(self) -> list[dict]:
-        """The runs whose weights this model's run started from (``--init-from``), nearest first."""
-        return lineage(self.meta)
+        self.family = FAMILIES.get(self.meta.get("kind"))  # how its algorithm acts: discrete, stochastic
+        self.algo_name = get_experiment(self.experiment).algos[self.algo].description.split(",")[0]  # Dueling DDQN
+        self.lineage = lineage(self.meta)  # the runs whose weights its run started from (--init-from), nearest first
+        page = "cartpole" if self.experiment == "cartpole_v0" else self.experiment  # v0 shares CartPole's page
+        self.experiment_page = f"docs/experiments/{page}.md"
+        found = re.search(r"articles? ([\d/]+)$", get_experiment(self.experiment).description)  # the source article
+        self.article = ARTICLE_OF_ALGO.get((self.experiment, self.algo), found[1] if found else "")
 
     def from_scratch(self) -> tuple[int, float]:
         """Env steps and wall seconds of this run and every run it started from: what the model cost."""
         return cost_from_scratch(self.meta)
+
+    def preset(self) -> tuple[str, dict]:
+        """The name of the model's preset and that preset's values today (none where it was renamed since)."""
+        exp = get_experiment(self.experiment)
+        name = self.meta.get("preset") or exp.algo(self.algo).default_preset
+        try:
+            return name, to_dict(exp.preset(self.algo, name))
+        except Exception:  # a preset renamed since: compare with nothing
+            return name, {}
 
 
 def read_json(path: Path) -> dict:
@@ -87,11 +103,8 @@ def shipped_models() -> list[Model]:
 
 
 def kept_sweeps() -> dict[tuple[str, str], Sweep]:
-    """(experiment, model) -> the sweep over seeds of that model's recipe kept in results/sweeps.
-
-    Only sweeps without a grid count (one recipe, several seeds). Scores come from each run's
-    meta.json; the IQM and its interval from report.md, which must list the same scores (else the
-    report is stale and the generator says so)."""
+    """(experiment, model) -> the sweep over seeds (without a grid) of that model's recipe kept in results/sweeps:
+    scores from each run's meta.json, aggregates from report.md, which must list the same scores (else it is stale)."""
     found = {}
     for sweep_json in sorted((REPO / "results" / "sweeps").glob("*/sweep.json")):
         sweep, folder = read_json(sweep_json), sweep_json.parent.relative_to(REPO)
@@ -118,3 +131,51 @@ def model_of(sweep: dict) -> str:
         return sweep["algo"]
     preset, overrides = exp.preset(sweep["algo"], sweep.get("preset")), sweep.get("overrides") or {}
     return "-".join(str(overrides.get(f, getattr(preset, f))) for f in exp.shipped_by.fields)
+
+
+def kept_runs(experiment: str) -> list[tuple[Model, list[dict]]]:
+    """Each shipped model of ``experiment`` with a kept sweep, and its runs by seed: meta.json, folder, story."""
+    found = []
+    for m in (m for m in shipped_models() if m.experiment == experiment and m.sweep is not None):
+        solved = get_experiment(experiment).solved_score
+        runs = [(read_json(path), path.parent.parent) for path in (REPO / m.sweep.folder).glob("*/model/meta.json")]
+        found.append((m, sorted([dict(meta=meta, folder=run, story=story(run, meta, solved)) for meta, run in runs],
+                                key=lambda run: run["meta"]["seed"])))
+    return found
+
+
+def csv_columns(experiments: str) -> list[tuple[str, str, str, dict[str, bool]]]:
+    """(file, experiment, trainer, {column: in every such file}) per CSV of the shipped models (of ``a/b``, or all)."""
+    seen: dict[tuple[str, str, str], list[list[str]]] = {}
+    for m in (m for m in shipped_models() if not experiments or m.experiment in experiments.split("/")):
+        for path in sorted((REPO / m.folder).glob("*.csv")):
+            with path.open() as f:
+                seen.setdefault((m.experiment, m.meta.get("kind", m.algo), path.name), []).append(
+                    f.readline().strip().split(","))
+    return [(name, experiment, kind, {c: all(c in h for h in headers) for header in headers for c in header})
+            for (experiment, kind, name), headers in seen.items()]
+
+
+def flag_value(value) -> str:
+    """A preset's value as its flag takes it: ``true``, ``64,64``, ``0.0003``."""
+    if isinstance(value, bool):
+        return str(value).lower()
+    if isinstance(value, tuple):
+        return ",".join(map(str, value)) or "(empty)"
+    return f"{value:g}" if isinstance(value, float) else str(value)
+
+
+def preset_fields(spec) -> list[tuple[dataclasses.Field, list[str], str]]:
+    """(field, its value in each preset, the values it allows in words) per field of an algorithm's default preset."""
+    return [(f, [flag_value(getattr(p, f.name)) if hasattr(p, f.name) else "–" for p in spec.presets.values()],
+             field_words(f) or ("true or false" if f.type in (bool, "bool") else ""))
+            for f in dataclasses.fields(spec.presets[spec.default_preset])]
+
+
+def cli_help() -> dict[str, str]:
+    """The parser's own ``--help`` (key ``""``) and each subcommand's, 100 characters wide whatever the terminal."""
+    parser = build_parser(["list"])
+    subcommands = next((a.choices for a in parser._actions if isinstance(a, argparse._SubParsersAction)), {})
+    for sub in (parser, *subcommands.values()):
+        sub.formatter_class = functools.partial(sub.formatter_class, width=100)
+    return {name: sub.format_help().rstrip() for name, sub in {"": parser, **subcommands}.items()}

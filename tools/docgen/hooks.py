@@ -1,8 +1,7 @@
-"""MkDocs hook (mkdocs.yml ``hooks:``): serve the shipped models' plots and training logs, the kept
-sweeps' reports and curves and the long runs' figure from where they live, as if under docs/, without a second copy. The pages link
-to them by their true place (``../../saved_networks/...`` from ``docs/models/``), which works where the
-pages are read as files (GitHub, an editor); for the site, :func:`on_page_markdown` points each such
-link at the mounted copy."""
+"""MkDocs hook (mkdocs.yml ``hooks:``): serve the shipped models' plots and training logs, the kept sweeps' reports
+and curves and the long runs' figure from where they live, as if under docs/, without a second copy. The pages link to
+them by their true place (``../../saved_networks/...`` from ``docs/models/``), which works where the pages are read as
+files (GitHub, an editor); for the site, :func:`on_page_markdown` points each such link at the mounted copy."""
 import posixpath
 import re
 from pathlib import Path

@@ -124,8 +124,7 @@ def test_a_sweep_whose_runs_log_q_and_runs_that_do_not_shows_each_that_does(tmp_
 def test_the_docs_table_of_a_mixed_sweep_gives_each_seeds_critic_or_a_dash(tmp_path, monkeypatch):
     from rlcore.environments.registry import get_experiment
     from tools.docgen import data as docgen_data
-    from tools.docgen import regions as docgen  # noqa: F401  (imported before REPO moves)
-    from tools.docgen import sweeps as docgen_sweeps
+    from tools.docgen import main as docgen  # imported before REPO moves
 
     _sweep_of_mixed_runs(tmp_path / "results" / "sweeps" / "cartpole__dqn")
     monkeypatch.setattr(docgen_data, "REPO", tmp_path)
@@ -134,7 +133,7 @@ def test_the_docs_table_of_a_mixed_sweep_gives_each_seeds_critic_or_a_dash(tmp_p
                               {"algo": "dqn", "seed": 0, "evaluation": {"episodes": 100, "mean": 500.0}},
                               get_experiment("cartpole").bar("dqn"), kept)
     monkeypatch.setattr(docgen_data, "shipped_models", lambda: [model])
-    rows = [line for line in docgen_sweeps.sweep_stability("docs/x.md", "cartpole").splitlines()
+    rows = [line for line in docgen.render("regions/sweep-stability.md", page="docs/x.md", arg="cartpole").splitlines()
             if line.startswith("| ")]
     assert rows[0].endswith("| critic at the end: mean Q |") and rows[1].count("|") == rows[0].count("|")
     cells = {row.split("|")[1].strip(): row.split("|")[-2].strip() for row in rows[2:]}
