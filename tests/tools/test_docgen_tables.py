@@ -44,3 +44,16 @@ def test_csv_columns_are_those_of_every_file(tmp_path, monkeypatch):
     assert "in some of the shipped models' files only" in text
     monkeypatch.setattr(docgen_data, "shipped_models", lambda: [new])
     assert "*" not in docgen.render("regions/csv-columns.md", page="docs/x.md", arg="mario_ppo").replace("`", "")
+
+
+def test_a_card_says_where_the_misses_ended_and_what_ended_them(tmp_path):
+    """Issue 63: a level short of its bar says where it stalls. Misses by x in blocks of 100 with their cause (the
+    enemy's name, a fall, the stall limit), most first; the episodes that reached the flag are not counted."""
+    episodes = [{"success": True, "x_pos": 3161.0}, {"success": False, "x_pos": 2674.0, "stalled": 1.0},
+                {"success": False, "x_pos": 2690.0, "stalled": 1.0}, {"success": False, "x_pos": 1734.0, "killed_by": 6.0},
+                {"success": False, "x_pos": 2450.0, "killed_by": -1.0}, {"success": False, "x_pos": 2460.0}]
+    model = _model(tmp_path, "1-2", {"evaluation": {"success_share": 1 / 6, "episodes": 6, "per_episode": episodes}})
+    assert docgen.miss_places(model) == ("2,600-2,699: stalled 2; 1,700-1,799: Goomba 1; 2,400-2,499: fell 1; "
+                                         "2,400-2,499: no cause recorded 1")
+    assert docgen.miss_places(_model(tmp_path, "1-3", {"evaluation": {"success_share": 1.0, "episodes": 1,
+                                                                      "per_episode": episodes[:1]}})) == ""
