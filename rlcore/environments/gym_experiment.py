@@ -232,28 +232,8 @@ def _missing_dependency(spec: EnvSpec, exc: Exception) -> str:
 
 
 def _build(name: str, env_kwargs: dict) -> Experiment:
-    import gymnasium as gym
-
     spec = gym_spec(name)
-    if env_kwargs:
-        check_env_kwargs(spec.id, env_kwargs)
-    try:
-        env = make_gym_env(name=name, env_kwargs=env_kwargs)
-    except gym.error.DependencyNotInstalled as exc:
-        raise UserError(_missing_dependency(spec, exc)) from None
-    except UserError:
-        raise
-    except Exception as exc:  # a value the env's own checks refuse, whatever it raises (ale-py: RuntimeError)
-        if not env_kwargs:
-            raise
-        said = exc if isinstance(exc, (TypeError, ValueError, AssertionError)) else f"{type(exc).__name__}: {exc}"
-        raise UserError(f"--env-kwargs: {spec.id} refused {env_kwargs}: {said}") from None
-    try:
-        obs_space, act_space = env.observation_space, env.action_space
-        one_hot_obs = type(env.unwrapped.observation_space).__name__ == "Discrete"  # given one-hot
-        fps = int(env.metadata.get("render_fps") or 30)
-    finally:
-        env.close()
+    obs_space, act_space, one_hot_obs, fps = _probe(spec, name, env_kwargs)
     algos, unfit = {}, {}
     for algo, (kind, description, switches) in algorithms().items():
         reason = misfit(kind, obs_space, act_space)
@@ -283,6 +263,33 @@ def _build(name: str, env_kwargs: dict) -> Experiment:
                     "observations_one_hot": one_hot_obs, **({"env_kwargs": env_kwargs} if env_kwargs else {}),
                     **({"atari_preprocessing": atari.record()} if atari.is_atari(spec.id) else {})},
     )
+
+
+def _probe(spec, name: str, env_kwargs: dict) -> tuple:
+    """Make the env once: its observation and action spaces, whether its observations come one-hot (a
+    Discrete space), its frame rate; what the env's own checks refuse of ``env_kwargs`` is one line."""
+    import gymnasium as gym
+
+    if env_kwargs:
+        check_env_kwargs(spec.id, env_kwargs)
+    try:
+        env = make_gym_env(name=name, env_kwargs=env_kwargs)
+    except gym.error.DependencyNotInstalled as exc:
+        raise UserError(_missing_dependency(spec, exc)) from None
+    except UserError:
+        raise
+    except Exception as exc:  # a value the env's own checks refuse, whatever it raises (ale-py: RuntimeError)
+        if not env_kwargs:
+            raise
+        said = exc if isinstance(exc, (TypeError, ValueError, AssertionError)) else f"{type(exc).__name__}: {exc}"
+        raise UserError(f"--env-kwargs: {spec.id} refused {env_kwargs}: {said}") from None
+    try:
+        obs_space, act_space = env.observation_space, env.action_space
+        one_hot_obs = type(env.unwrapped.observation_space).__name__ == "Discrete"  # given one-hot
+        fps = int(env.metadata.get("render_fps") or 30)
+    finally:
+        env.close()
+    return obs_space, act_space, one_hot_obs, fps
 
 
 def _jsonable(kwargs: dict) -> dict:
