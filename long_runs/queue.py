@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Issue 63's trainings, one at a time and in order, each resumed where it stopped: every Mario level
 from 1-1 to 2-4 from one command (the ``flag`` preset, fixed on 2026-12-03 before the first of these
-runs), plus two lever runs that measure a cheaper recipe (``--epochs 4``) on 1-1 and on 2-1 against it.
+runs), plus two lever runs that measure a cheaper recipe (``--epochs 4``) on 1-1 and on 2-1 against it, each
+stopped at the flag share 0.9 or at 1.5x the env steps its baseline took to reach it (:func:`lever_limits`).
 Each level's run is then evaluated on 30 further unseen seeds.
 
     .venv/bin/python long_runs/queue.py --dry-run     # the next command, from the folders' state
@@ -43,6 +44,9 @@ RUNS = (("1-1", "1-1", []), ("1-1-epochs-4", "1-1", ["--epochs", "4"]),
         *((level, level, []) for level in LEVELS if level not in ("1-1", "2-1")))
 
 
+LEVER_SHARE, LEVER_MARGIN = 0.9, 1.5  # where a lever run stops (lever_limits)
+
+
 def run_dir(name: str) -> str:
     return f"long_runs/mario_ppo/{name}"
 
@@ -80,8 +84,25 @@ def next_command(folders: Path = HERE) -> list[str] | None:
             continue
         if (run / "checkpoint.npz").is_file():
             return ["train", "mario_ppo", "ppo", "--resume", run_dir(name), *QUIET]
-        return train_command(name, level, extra)
+        return train_command(name, level, extra + (lever_limits(level, folders) if extra else []))
     return None
+
+
+def lever_limits(level: str, folders: Path = HERE) -> list[str]:
+    """A lever run's stop, fixed when it starts from its baseline (the level's run of the recipe, which trains
+    before it): the flag share 0.9, or 1.5x the env steps the baseline took to first reach that share (where it
+    never did, the baseline's env steps), within the recipe's budget. 4 epochs cost 1/1.23 of 10 per env step
+    (benchmarks/mario_recipe.py), so a lever run that needs over 1.23x its baseline's env steps to the same share
+    is not cheaper; the margin leaves room for a seed's luck. Set 2026-12-07, before either lever run started."""
+    from mario_ppo.experiment import FLAG
+
+    baseline = shipped(level, folders) or folders / run_dir(level)
+    steps, shares = flag_curve(baseline / "metrics.csv")
+    reached = next((step for step, share in zip(steps, shares) if share >= LEVER_SHARE), None)
+    rows = _rows(baseline / "metrics.csv") or []
+    budget = round(LEVER_MARGIN * reached) if reached else int(float(rows[-1]["env_steps"])) if rows else None
+    return ["--stop-success-share", str(LEVER_SHARE)] + (
+        ["--steps", str(min(budget, FLAG.max_env_steps))] if budget else [])
 
 
 def _evaluated(meta: Path) -> bool:

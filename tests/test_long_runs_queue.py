@@ -41,8 +41,8 @@ def test_the_queue_trains_each_run_in_order_resumes_it_then_evaluates_it_on_30_f
     steps.append(queue.next_command(tmp_path))
     assert steps[-1][:2] == ["evaluate", "mario_ppo"] and "--record-further" in steps[-1]
     _finish(first, evaluation={"episodes": 30}, further_evaluations=[{"episodes": 30}])
-    steps.append(queue.next_command(tmp_path))  # the lever run: the same recipe with 4 epochs
-    assert steps[-1] == queue.train_command("1-1-epochs-4", "1-1", ["--epochs", "4"])
+    steps.append(queue.next_command(tmp_path))  # the lever run: the same recipe with 4 epochs, stopped at 0.9
+    assert steps[-1] == queue.train_command("1-1-epochs-4", "1-1", ["--epochs", "4", "--stop-success-share", "0.9"])
     for name, _, _ in queue.RUNS:
         _finish(tmp_path / queue.run_dir(name), evaluation={"episodes": 30}, further_evaluations=[{"episodes": 30}])
     assert queue.next_command(tmp_path) is None
@@ -118,7 +118,8 @@ def test_a_shipped_level_is_done_and_read_from_its_model_folder(tmp_path):
     (target / "metrics.csv").write_text("episode,success,env_steps,restarted\n" + "".join(
         f"{i},1,{100 * i},0\n" for i in range(1, 101)))
     assert queue.shipped("1-1", tmp_path) == target and queue.shipped("1-1-epochs-4", tmp_path) is None
-    assert queue.next_command(tmp_path) == queue.train_command("1-1-epochs-4", "1-1", ["--epochs", "4"])
+    assert queue.next_command(tmp_path) == queue.train_command("1-1-epochs-4", "1-1", [  # its baseline read there
+        "--epochs", "4", "--stop-success-share", "0.9", "--steps", "15000"])
     assert queue.run_status("1-1", tmp_path) == ("1-1: shipped to saved_networks/mario_ppo/1-1, finished at 7 env steps "
                                                  "(stop_success_share 0.95); flag on unseen seeds: 27 of 30")
     queue.plot(tmp_path / "plot.png", tmp_path)
@@ -141,3 +142,19 @@ def test_the_flag_curve_counts_the_last_100_episodes_from_the_levels_start(tmp_p
     assert shares[-1] == sum(i % 2 == 0 for i in window) / 100
     queue.plot(tmp_path / "flag_share.png", folders=tmp_path)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["flag_share.png", "long_runs"]
+
+
+def test_a_lever_run_stops_at_the_share_0_9_or_at_1_5x_its_baselines_env_steps_to_it(tmp_path):
+    """4 epochs are 1.23x faster per env step: a lever run that needs 1.5x its baseline's env steps to the same
+    share cannot be cheaper, so it stops there; where the baseline never reached 0.9, at the baseline's env steps."""
+    baseline = tmp_path / queue.run_dir("2-1")
+    baseline.mkdir(parents=True)
+    header = "episode,success,env_steps,restarted\n"
+    rows = [f"{i},{int(i >= 20)},{1000 * i},0" for i in range(1, 121)]  # episodes 10-109: 90 flags
+    (baseline / "metrics.csv").write_text(header + "\n".join(rows) + "\n")
+    assert queue.lever_limits("2-1", tmp_path) == ["--stop-success-share", "0.9", "--steps", str(round(1.5 * 109_000))]
+    rows = [f"{i},{int(i % 2)},{1000 * i},0" for i in range(1, 201)]  # never past 0.5
+    (baseline / "metrics.csv").write_text(header + "\n".join(rows) + "\n")
+    assert queue.lever_limits("2-1", tmp_path) == ["--stop-success-share", "0.9", "--steps", "200000"]
+    args = _parses(queue.train_command("2-1-epochs-4", "2-1", ["--epochs", "4", *queue.lever_limits("2-1", tmp_path)]))
+    assert (args.hp_epochs, args.hp_stop_success_share, args.steps) == (4, 0.9, 200_000)
