@@ -3,12 +3,11 @@
 returns. Re-exported by :mod:`rlcore.api`."""
 from __future__ import annotations
 
-import contextlib
 import os
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Iterator, Literal, Union
+from typing import TYPE_CHECKING, Any, Literal, Union
 
 os.environ.setdefault("TF_CPP_MIN_LOG_LEVEL", "2")  # before anything imports TensorFlow, as main.py does
 import numpy as np
@@ -75,8 +74,7 @@ class Policy:
 
     def make_env(self, render_mode: str | None = None) -> gymnasium.Env:
         """The model's env (``render_mode="rgb_array"`` for frames)."""
-        env: gymnasium.Env = self._network.make_env(render_mode=render_mode)
-        return env
+        return self._network.make_env(render_mode=render_mode)
 
     def predict(self, observation: Any, deterministic: bool = True,
                 rng: np.random.Generator | None = None) -> Any:
@@ -93,17 +91,13 @@ class Policy:
         if batch.shape[1:] != self.observation_shape:
             raise UserError(f"observation of shape {obs.shape} given; this model takes "
                             f"{self.observation_shape} (or a batch of them)")
-        actions = self._network(batch) if deterministic else self._sample(batch, rng or np.random.default_rng())
+        network = self._network
+        actions = network(batch) if deterministic else network.sample(batch, rng or np.random.default_rng())
         return actions[0].item() if single and actions.ndim == 1 else (actions[0] if single else actions)
-
-    def _sample(self, batch: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-        sampled: np.ndarray = self._network.sample(batch, rng)
-        return sampled
 
     def __call__(self, observations: np.ndarray) -> np.ndarray:
         """Greedy actions for a batch (the interface rlcore's evaluation and video code call)."""
-        actions: np.ndarray = self._network(observations)
-        return actions
+        return self._network(observations)
 
 
 # ------------------------------------------------------------------------------- load
@@ -113,6 +107,7 @@ def model_folder(model: str | os.PathLike[str] | tuple[str, str]) -> Path:
     returned as it is (:func:`load` reads its last checkpoint)."""
     from rlcore.environments.registry import get_experiment
     from rlcore.models import shipping
+    from rlcore.models.snapshot import given_folder
 
     if isinstance(model, tuple):
         if len(model) != 2 or not all(isinstance(part, str) for part in model):
@@ -129,10 +124,7 @@ def model_folder(model: str | os.PathLike[str] | tuple[str, str]) -> Path:
     if not isinstance(model, (str, os.PathLike)):
         raise UserError(f"a model is a folder's path, a shipped model's (EXPERIMENT, ALGO or LEVEL) such as "
                         f"('lunar_lander', 'dqn'), a Run or a Policy; got {model!r}")
-    folder = Path(model)
-    finished = folder / "model"
-    if (finished / "meta.json").is_file() and not (folder / "meta.json").is_file():
-        return finished
+    folder = given_folder(Path(model))
     if not any((folder / name).is_file() for name in ("meta.json", "checkpoint.npz")):
         if pair := _shipped_name(str(model)):  # "lunar_lander" or "lunar_lander/dqn" meant a shipped model
             raise UserError(f"{model} is not a model folder; a shipped model is named as a pair: {pair}")
@@ -237,9 +229,7 @@ def render_policy(policy: Policy, out: Path, fps: int | None, episodes: int | No
     exp, network = policy.experiment, policy._network
     count = exp.episodes_per_video if episodes is None else episodes
     act = network.sample if exp.goal else None  # Mario plays as it was evaluated
-    result: dict[str, Any] = record_video(exp, network, out, fps or exp.video_fps, count, seed,
-                                          make_env=network.make_env, act=act)
-    return result
+    return record_video(exp, network, out, fps or exp.video_fps, count, seed, make_env=network.make_env, act=act)
 
 
 @named_as_python
@@ -255,12 +245,5 @@ def export(model: ModelRef | Policy, format: ExportFormat, out: str | os.PathLik
     load_tensorflow()
     # a run in progress is exported from its last checkpoint, and its record says so, as the CLI's does
     source = f"{policy.model_dir}, last checkpoint" if policy._keep is not None else str(policy.model_dir)
-    with _snapshot_folder(policy) as folder:
-        record: dict[str, Any] = export_model(folder, format, out, observations=observations, source=source)
-    return record
-
-
-@contextlib.contextmanager
-def _snapshot_folder(policy: Policy) -> Iterator[Path]:
-    """The folder that holds the policy's files (a run in progress: its snapshot)."""
-    yield Path(policy._keep.name) if policy._keep is not None else policy.model_dir
+    folder = Path(policy._keep.name) if policy._keep is not None else policy.model_dir  # a run's: its snapshot
+    return export_model(folder, format, out, observations=observations, source=source)

@@ -36,9 +36,9 @@ def _model_dir(args) -> Path:
         exp.algo(args.algo)  # unknown names -> clear error; a model's own env (--env-kwargs) is read from it
     given = _shipped_choice(args)
     if not given and args.model:
-        folder = Path(args.model)
-        finished = folder / "model"  # a finished run's folder: its model
-        return finished if (finished / "meta.json").is_file() and not (folder / "meta.json").is_file() else folder
+        from rlcore.models.snapshot import given_folder
+
+        return given_folder(args.model)
     if not given:
         return shipping.require_shipped(shipping.shipped_dir(args.experiment, args.algo),
                                         f"{args.experiment} {args.algo}")

@@ -16,6 +16,14 @@ from rlcore.models.policies import config_from_meta
 from rlcore.training.spec import CHECKPOINT_FILE
 
 
+def given_folder(folder: str | Path) -> Path:
+    """The folder a ``--model`` (or ``api.load``) path stands for: a finished run's folder stands for its
+    ``model/``; a model folder or a run in progress, for itself."""
+    folder = Path(folder)
+    finished = folder / "model"
+    return finished if (finished / "meta.json").is_file() and not (folder / "meta.json").is_file() else folder
+
+
 def is_run_in_progress(folder: str | Path) -> bool:
     """A run folder with a checkpoint and no finished model of its own."""
     folder = Path(folder)
