@@ -3,6 +3,8 @@
 trained on. TensorFlow-free."""
 from __future__ import annotations
 
+from itertools import groupby
+
 
 def cpus_text(meta: dict) -> str | None:
     """The CPUs a run trained on: where its commands recorded theirs (from 2026-11-29 on) and a resume moved
@@ -12,10 +14,7 @@ def cpus_text(meta: dict) -> str | None:
     cpus = [(int((start or {}).get("env_steps", 0)), (start or {}).get("cpu")) for start in command_starts(meta)]
     if not any(cpu for _, cpu in cpus):
         return meta.get("cpu")
-    changes: list[tuple[int, str | None]] = []
-    for steps, cpu in cpus:
-        if not changes or changes[-1][1] != cpu:
-            changes.append((steps, cpu))
+    changes = [next(same) for _, same in groupby(cpus, key=lambda start: start[1])]  # where the CPU changed
     return "; ".join((cpu or "not recorded") + ("" if i == 0 else f" from {steps:,} env steps")
                      for i, (steps, cpu) in enumerate(changes))
 

@@ -10,8 +10,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from rlcore.files.atomic import atomic_path  # noqa: E402
 from rlcore.errors import UserError  # noqa: E402
+from rlcore.files.atomic import atomic_path  # noqa: E402
 
 ABOUT_KEYS = ("experiment", "algo", "preset", "seed", "config")  # what a plot's title and window need
 
@@ -20,7 +20,7 @@ def plot_run(run_dir: str | Path, out_dir: str | Path, experiment, about: dict) 
     """Every plot a run's CSV tables allow, written to ``out_dir``; the first is the score plot.
 
     ``about`` says what the run trained (``algo``, ``preset``, ``seed``, ``config``), as a checkpoint's
-    state or a ``meta.json`` does. Reads ``metrics.csv`` (one row per episode) and, when present,
+    state or a ``meta.json`` does. Reads ``metrics.csv`` (one row per episode) once and, when present,
     ``evals.csv``; experiments with a goal that measures progress (``Goal.progress_key``) also get the
     progress and endings plots, and with a cause of failure (``Goal.cause_key``) the Deaths plot.
     """
@@ -35,17 +35,16 @@ def plot_run(run_dir: str | Path, out_dir: str | Path, experiment, about: dict) 
     label = experiment.score_label
     metrics, evals = run_dir / "metrics.csv", run_dir / "evals.csv"
     goal = experiment.goal
-    partial_key = experiment.curriculum.partial_key if experiment.curriculum else None
-    out = [plot_episode_scores(metrics, out_dir / f"{prefix}_Train_{algo}.png", title,
-                               experiment.solved_score, label, partial_key)]
+    df = read_table(metrics, "episode", "total_points", "av_latest_points")
+    full = full_episodes(df, experiment.curriculum.partial_key if experiment.curriculum else None)
+    out = [plot_episode_scores(df, full, out_dir / f"{prefix}_Train_{algo}.png", title, experiment.solved_score, label)]
     if goal and goal.progress_key:
-        out.append(plot_progress(metrics, out_dir / f"{prefix}_Progress_{algo}.png", title,
-                                 goal.progress_key, window, partial_key))
-        out.append(plot_endings(metrics, out_dir / f"{prefix}_Endings_{algo}.png", title,
-                                goal.progress_key, partial_key))
-    if goal and goal.cause_key and _has_values(metrics, goal.cause_key):
-        out.append(plot_causes(metrics, out_dir / f"{prefix}_Deaths_{algo}.png", title,
-                               goal.cause_key, goal.cause_name))
+        if goal.progress_key not in df:  # checked after the score plot, as its own read of the table did
+            raise UserError(f"{metrics} is damaged or not one of ours (no column {goal.progress_key})")
+        out.append(plot_progress(full, out_dir / f"{prefix}_Progress_{algo}.png", title, goal.progress_key, window))
+        out.append(plot_endings(full, out_dir / f"{prefix}_Endings_{algo}.png", title, goal.progress_key))
+    if goal and goal.cause_key and goal.cause_key in df and df[goal.cause_key].notna().any():
+        out.append(plot_causes(df, out_dir / f"{prefix}_Deaths_{algo}.png", title, goal.cause_key, goal.cause_name))
     if evals.exists():
         out.append(plot_evaluations(evals, out_dir / f"{prefix}_Eval_{algo}.png", title,
                                     experiment.solved_score, label))
@@ -60,14 +59,11 @@ def plot_title(experiment, about: dict) -> str:
             f"({about['preset']} preset, seed {about['seed']})")
 
 
-def plot_episode_scores(csv_path: str | Path, png_path: str | Path, title: str,
-                        solved_score: float | None = None, score_label: str = "return",
-                        partial_key: str | None = None) -> Path:
-    """Score per episode, its moving average and the solved line, as in article 000's figure.
-    Episodes marked by ``partial_key`` (Mario's restarts) are left out, and the average is taken
-    over the others."""
-    df = read_table(csv_path, "episode", "total_points", "av_latest_points")
-    full = full_episodes(df, partial_key)
+def plot_episode_scores(df: pd.DataFrame, full: pd.DataFrame, png_path: str | Path, title: str,
+                        solved_score: float | None = None, score_label: str = "return") -> Path:
+    """Score per episode (metrics.csv's ``df``), its moving average and the solved line, as in article 000's
+    figure. Only the episodes from the start (``full``, :func:`full_episodes`: Mario's restarts left out) are
+    drawn, and the average is taken over them."""
     if len(full) < len(df):  # the logged average counted every episode: take it over these only
         df = full.assign(av_latest_points=full["total_points"].rolling(100, min_periods=1).mean())
     fig, ax = plt.subplots(figsize=(9, 5))
@@ -96,12 +92,10 @@ def plot_evaluations(csv_path: str | Path, png_path: str | Path, title: str,
     return _save(fig, ax, title, png_path)
 
 
-def plot_progress(csv_path: str | Path, png_path: str | Path, title: str, progress_key: str,
-                  window: int = 100, partial_key: str | None = None) -> Path:
+def plot_progress(df: pd.DataFrame, png_path: str | Path, title: str, progress_key: str, window: int = 100) -> Path:
     """Episodes with a goal (Mario's flag): how far each got (``progress_key``, with its moving
     average) and, on the right axis, the share of the last ``window`` episodes that succeeded.
-    Episodes marked by ``partial_key`` (Mario's restarts, which start further in) are left out."""
-    df = full_episodes(read_table(csv_path, "episode", progress_key), partial_key)
+    ``df``: metrics.csv's episodes from the start (:func:`full_episodes`; Mario's restarts start further in)."""
     fig, ax = plt.subplots(figsize=(9, 5))
     ax.plot(df["episode"], df[progress_key], color="tab:blue", linewidth=1, alpha=0.5, label=progress_key)
     ax.plot(df["episode"], df[progress_key].rolling(window, min_periods=1).mean(), color="tab:orange",
@@ -135,12 +129,10 @@ def ending_shares(progress: np.ndarray, block: int, bins: int = 40) -> tuple[np.
     return starts + 1, edges, shares
 
 
-def plot_endings(csv_path: str | Path, png_path: str | Path, title: str, progress_key: str,
-                 partial_key: str | None = None, blocks: int = 60) -> Path:
+def plot_endings(df: pd.DataFrame, png_path: str | Path, title: str, progress_key: str, blocks: int = 60) -> Path:
     """A map of where episodes ended (``progress_key``, e.g. Mario's x) over training: the dark rows
     are where the agent keeps dying or stalling. Episodes with a ``stalled`` mark add its share.
-    Episodes marked by ``partial_key`` (Mario's restarts, which start further in) are left out."""
-    df = full_episodes(read_table(csv_path, "episode", progress_key), partial_key)
+    ``df``: metrics.csv's episodes from the start (:func:`full_episodes`; Mario's restarts start further in)."""
     block = max(1, int(np.ceil(len(df) / blocks)))
     starts, edges, shares = ending_shares(df[progress_key].to_numpy(), block)
     fig, ax = plt.subplots(figsize=(9, 5))
@@ -158,7 +150,7 @@ def plot_endings(csv_path: str | Path, png_path: str | Path, title: str, progres
         share.set_ylabel("stalled, %")
         share.legend(loc="upper left")
     ax.set_title(title)
-    return _write(fig, png_path)
+    return write_png(fig, png_path)
 
 
 def cause_shares(causes: pd.Series, block: int, most: int = 6) -> pd.DataFrame:
@@ -176,12 +168,11 @@ def cause_shares(causes: pd.Series, block: int, most: int = 6) -> pd.DataFrame:
     return shares.rename_axis(index=None, columns=None)
 
 
-def plot_causes(csv_path: str | Path, png_path: str | Path, title: str, cause_key: str, cause_name,
+def plot_causes(df: pd.DataFrame, png_path: str | Path, title: str, cause_key: str, cause_name,
                 blocks: int = 60) -> Path:
     """What ends the failed episodes (``cause_key``, e.g. Mario's killed_by) over training, as
     shares of the failures of each block of episodes, from the first episode that logged a cause;
-    restarted episodes included."""
-    df = read_table(csv_path, "episode", cause_key)
+    ``df``: metrics.csv's rows, restarted episodes included."""
     df = df.loc[df[cause_key].first_valid_index():]  # a run resumed by newer code logs it from there on
     causes = df[cause_key].map(cause_name, na_action="ignore")
     block = max(20, int(np.ceil(len(df) / blocks)))  # fewer blocks while a few hundred are logged
@@ -198,15 +189,7 @@ def plot_causes(csv_path: str | Path, png_path: str | Path, title: str, cause_ke
     ax.set_xlim(edges[0], edges[-1])
     ax.legend(loc="upper left", fontsize="small", title=cause_key)
     ax.set_title(title)
-    return _write(fig, png_path)
-
-
-def _has_values(csv_path: Path, column: str) -> bool:
-    """``csv_path`` exists and its ``column`` holds a value in some row."""
-    if not csv_path.exists():
-        return False
-    df = pd.read_csv(csv_path, usecols=lambda name: name == column)
-    return column in df and df[column].notna().any()
+    return write_png(fig, png_path)
 
 
 def full_episodes(df: pd.DataFrame, partial_key: str | None) -> pd.DataFrame:
@@ -231,13 +214,13 @@ def _save(fig, ax, title, png_path) -> Path:
     ax.set_title(title)
     ax.grid(alpha=0.3)
     ax.legend(loc="lower right")
-    return _write(fig, png_path)
+    return write_png(fig, png_path)
 
 
-def _write(fig, png_path) -> Path:
-    """The figure as a PNG, written whole or not at all, then closed."""
+def write_png(fig, png_path: str | Path, dpi: int = 100, then: str = "resume the run") -> Path:
+    """The figure as a PNG, written whole or not at all, then closed; ``then``: what to do after a failed write."""
     fig.tight_layout()
-    with atomic_path(png_path) as tmp:
-        fig.savefig(tmp, dpi=100)
+    with atomic_path(png_path, then) as tmp:
+        fig.savefig(tmp, dpi=dpi)
     plt.close(fig)
     return Path(png_path)

@@ -30,18 +30,6 @@ def has_column(run_dir: Path, column: str) -> bool:
         return column in next(csv.reader(f), [])
 
 
-def learning_curve(run_dirs: list[Path], points: int = 40,
-                   column: str = AVERAGE_RETURN) -> tuple[np.ndarray, np.ndarray]:
-    """(env steps grid, [runs, points] of ``column``: the 100-episode average return), each run interpolated.
-
-    The grid ends where the shortest run ends, so every point aggregates every run.
-    """
-    curves = [run_curve(d, column) for d in run_dirs]
-    end = min(s[-1] for s, _ in curves)
-    grid = np.linspace(0, end, points)
-    return grid, np.stack([np.interp(grid, s, v) for s, v in curves])
-
-
 def _iqm_band(curves: np.ndarray, reps: int, seed: int = 0) -> tuple[list, list, list]:
     """IQM over runs at each column of a [runs, points] matrix, with its 95 % bootstrap interval.
 
@@ -61,26 +49,17 @@ def _iqm_band(curves: np.ndarray, reps: int, seed: int = 0) -> tuple[list, list,
 
 
 def _save_figure(fig, ax, ylabel: str, out: Path) -> Path:
-    import matplotlib.pyplot as plt
-
-    from rlcore.files.atomic import atomic_path
+    from rlcore.records.plotting import write_png
 
     ax.set_xlabel("env steps")
     ax.set_ylabel(ylabel)
     ax.legend()
     ax.grid(alpha=0.3)
-    fig.tight_layout()
-    out = Path(out)
-    with atomic_path(out, then="report again") as tmp:
-        fig.savefig(tmp, dpi=110)
-    plt.close(fig)
-    return out
+    return write_png(fig, out, dpi=110, then="report again")
 
 
 def _figure():
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from rlcore.records.plotting import plt  # matplotlib without a display (Agg)
 
     return plt.subplots(figsize=(8, 4.5))
 
@@ -89,19 +68,21 @@ def plot_curves(result: dict, out: Path, reps: int = 1000, column: str = AVERAGE
     """IQM of the 100-episode average return (or another of metrics.csv's ``column``) over env steps, with
     its 95 % CI band, per sweep. ``None`` (no file) where no sweep's runs all log the column.
 
-    The band covers the env steps every run reached; each run is also drawn in full, thin.
+    The band covers the env steps every run reached (each run interpolated on 40 points up to where the
+    shortest ends, so every point aggregates every run); each run is also drawn in full, thin.
     """
     sweeps = [s for s in result["sweeps"] if all(has_column(r["run_dir"], column) for r in s["runs"])]
     if not sweeps:
         return None
     fig, ax = _figure()
     for s in sweeps:
-        grid, curves = learning_curve([r["run_dir"] for r in s["runs"]], column=column)
-        iqm, low, high = _iqm_band(curves, reps)
-        line, = ax.plot(grid, iqm, lw=2, label=f"{s['label']}: IQM of {count(len(s['runs']), 'run')}, 95% CI")
+        runs = [run_curve(r["run_dir"], column) for r in s["runs"]]  # (env steps, values) each
+        grid = np.linspace(0, min(steps[-1] for steps, _ in runs), 40)
+        iqm, low, high = _iqm_band(np.stack([np.interp(grid, *run) for run in runs]), reps)
+        line, = ax.plot(grid, iqm, lw=2, label=f"{s['label']}: IQM of {count(len(runs), 'run')}, 95% CI")
         ax.fill_between(grid, low, high, color=line.get_color(), alpha=0.25)
-        for r in s["runs"]:  # each run in full, since runs with an episode budget end at different steps
-            ax.plot(*run_curve(r["run_dir"], column), color=line.get_color(), lw=0.7, alpha=0.35)
+        for run in runs:  # each run in full, since runs with an episode budget end at different steps
+            ax.plot(*run, color=line.get_color(), lw=0.7, alpha=0.35)
     if column == SUCCESS_SHARE:
         word, stop = _goal(sweeps)
         if stop:  # where the runs' stop rule ends them

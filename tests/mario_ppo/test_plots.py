@@ -40,7 +40,7 @@ def test_mario_plots_leave_out_restarted_episodes(capsys, tmp_path, monkeypatch)
     rows = ["episode,total_points,av_latest_points,target_ave_scores,x_pos,success,success_share,restarted"]
     rows += [f"{i},{5 if i % 2 else 300},0,0,{3000 if i % 2 else 300 + i},0,0,{i % 2}" for i in range(1, 41)]
     write_run(tmp_path, rows)
-    ended_at, kept = [], []  # what the endings map and each plot were given
+    ended_at, kept, drawn = [], [], []  # what the endings map was given, the episodes kept, each curve's
     ending_shares, full_episodes = plotting.ending_shares, plotting.full_episodes
 
     def spy_ending_shares(x, *args, **kwargs):
@@ -53,10 +53,14 @@ def test_mario_plots_leave_out_restarted_episodes(capsys, tmp_path, monkeypatch)
 
     monkeypatch.setattr(plotting, "ending_shares", spy_ending_shares)
     monkeypatch.setattr(plotting, "full_episodes", spy_full_episodes)
+    for name, full_at in (("plot_episode_scores", 1), ("plot_progress", 0)):  # where each takes the episodes
+        monkeypatch.setattr(plotting, name, lambda *args, plot=getattr(plotting, name), at=full_at:
+                            drawn.append(args[at]) or plot(*args))
     code, _, err = run(capsys, "plot", str(tmp_path))
     assert code == 0, err
     assert sorted(ended_at) == [300 + i for i in range(2, 41, 2)]  # the 20 episodes from the start
-    assert len(kept) == 3 and all(len(df) == 20 and (df["restarted"] == 0).all() for df in kept)
+    assert len(kept) == 1 and len(kept[0]) == 20 and (kept[0]["restarted"] == 0).all()  # picked once
+    assert len(drawn) == 2 and all(df is kept[0] for df in drawn)  # and the curves drew those
 
 
 def test_ending_shares_say_where_each_block_of_episodes_ended():
