@@ -75,8 +75,8 @@ def resume(run: str | os.PathLike[str] | Run, *, episodes: int | None = None, st
     the run is (its env, networks, seed, preset, the model it started from) may not, and saying so raises
     :class:`UserError`.
     """
-    from rlcore.files.checkpoint import read_checkpoint_state
     from rlcore.environments.registry import require_experiment
+    from rlcore.files.checkpoint import read_checkpoint_state
     from rlcore.host.quiet import load_tensorflow
     from rlcore.hyperparams.flags import resuming_changes
     from rlcore.training.run import build_spec

@@ -196,11 +196,6 @@ def algorithms() -> dict[str, tuple[str, str, dict]]:
             for name, (description, switches) in fam.variants.items()}
 
 
-def misfit(kind: str, observation_space: gymnasium.Space, action_space: gymnasium.Space) -> str | None:
-    """Why an algorithm of ``kind`` cannot train on these spaces (one clause), or None when it can."""
-    return family(kind).misfit(observation_space, action_space)
-
-
 def default_preset(kind: str, switches: dict, reward_threshold: float | None) -> object:
     """The algorithm's config defaults, for an env this package knows nothing of."""
     fields = dict(max_episode_steps=0, stop_score=(NO_THRESHOLD_STOP if reward_threshold is None
@@ -236,7 +231,7 @@ def _build(name: str, env_kwargs: dict) -> Experiment:
     obs_space, act_space, one_hot_obs, fps = _probe(spec, name, env_kwargs)
     algos, unfit = {}, {}
     for algo, (kind, description, switches) in algorithms().items():
-        reason = misfit(kind, obs_space, act_space)
+        reason = family(kind).misfit(obs_space, act_space)  # why it cannot train on these spaces, or None
         if reason:
             unfit[algo] = reason
             continue
@@ -265,7 +260,7 @@ def _build(name: str, env_kwargs: dict) -> Experiment:
     )
 
 
-def _probe(spec, name: str, env_kwargs: dict) -> tuple:
+def _probe(spec: EnvSpec, name: str, env_kwargs: dict) -> tuple:
     """Make the env once: its observation and action spaces, whether its observations come one-hot (a
     Discrete space), its frame rate; what the env's own checks refuse of ``env_kwargs`` is one line."""
     import gymnasium as gym
@@ -293,8 +288,6 @@ def _probe(spec, name: str, env_kwargs: dict) -> tuple:
 
 
 def _jsonable(kwargs: dict) -> dict:
-    import json
-
     out = {}
     for key, value in (kwargs or {}).items():
         try:

@@ -110,14 +110,6 @@ def load_tensorflow() -> None:
     _loaded = True
 
 
-class _DropMessage(logging.Filter):
-    def __init__(self, fragment: str):
-        super().__init__()
-        self.fragment = fragment
-
-    def filter(self, record: logging.LogRecord) -> bool:
-        return self.fragment not in record.getMessage()
-
-
 #: Keras logs this through absl each time a model is saved as .h5, which the package does on purpose
-logging.getLogger("absl").addFilter(_DropMessage("You are saving your model as an HDF5 file"))
+logging.getLogger("absl").addFilter(
+    lambda record: "You are saving your model as an HDF5 file" not in record.getMessage())

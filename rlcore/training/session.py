@@ -8,10 +8,10 @@ It puts together the parts that each own one thing:
     PeriodicEvaluation   greedy evaluations, best weights               trainers/periodic_eval.py
     StopRequest          Ctrl-C, SIGTERM and a sweep's stop file        trainers/stopping.py
     StopRules            budgets and goals                              trainers/stopping.py
-    write_model_folder   model/ with meta.json                          trainers/model_folder.py
 
 and holds the run's counters (env steps, wall time, commands), which it writes into every
-checkpoint's state and restores from it. A trainer reads like its article's loop::
+checkpoint's state and restores from it, and at the end into the model folder's meta.json
+(:meth:`TrainingSession.finish`). A trainer reads like its article's loop::
 
     state, arrays = checkpoints.restore(spec, agent, rng, memory)
     session = TrainingSession(spec, state, resumed_arrays=arrays)
@@ -24,13 +24,15 @@ from __future__ import annotations
 
 import sys
 import time
+from datetime import datetime, timezone
 from pathlib import Path
 
 from rlcore.environments.seeding import training_env_seed
-from rlcore.files.atomic import writable_folder
+from rlcore.files.atomic import writable_folder, write_atomic, write_json
 from rlcore.host.cpu import cpu_description
+from rlcore.host.machine import package_versions
+from rlcore.records.plotting import plot_run
 from rlcore.training.episodes import EpisodeBook
-from rlcore.training.model_folder import write_model_folder
 from rlcore.training.periodic_eval import PeriodicEvaluation
 from rlcore.training.progress import Progress
 from rlcore.training.spec import CHECKPOINT_FILE, RunSpec
@@ -163,7 +165,8 @@ class TrainingSession:
         return self.finish(save_models, load_weights, **record)
 
     def finish(self, save_models, load_weights=None, **record) -> Path:
-        """Write the model folder: ``save_models(folder)`` writes the ``.h5`` files, then meta + plot.
+        """Write the model folder: ``save_models(folder)`` writes the ``.h5`` files, then the plot, every CSV
+        table and meta.json (what the run was, the commands that made it, its counters, the package versions).
 
         With ``keep_best``, ``load_weights(best_weights)`` first puts the best evaluation's weights
         back. ``record``: more for meta.json (e.g. PPO's ``init_from``).
@@ -172,14 +175,23 @@ class TrainingSession:
         kept_best = self.evaluation.keep_best and self.evaluation.best_weights is not None
         if kept_best:
             load_weights(self.evaluation.best_weights)
-        book = self.book
-        return write_model_folder(self.run_dir, self.spec.experiment, self.spec.describe(), save_models, {
-            "commands": self.commands, "command_starts": self.command_starts,
-            "env_steps": self.env_steps, "episodes": book.episodes,
-            "wall_seconds": round(self.elapsed(), 1), "solved_episode": book.solved_episode,
-            "final_average": round(book.average, 2), "stopped_by": self.stop_reason,
-            "weights": "best periodic evaluation" if kept_best else "last",
-            "best_eval": self.evaluation.best, **record})
+        book, describe = self.book, self.spec.describe()
+        record = {"commands": self.commands, "command_starts": self.command_starts,
+                  "env_steps": self.env_steps, "episodes": book.episodes,
+                  "wall_seconds": round(self.elapsed(), 1), "solved_episode": book.solved_episode,
+                  "final_average": round(book.average, 2), "stopped_by": self.stop_reason,
+                  "weights": "best periodic evaluation" if kept_best else "last",
+                  "best_eval": self.evaluation.best, **record}
+        model_dir = writable_folder(self.run_dir / "model", "model folder")
+        files = [p.name for p in save_models(model_dir)]
+        plot_name = plot_run(self.run_dir, model_dir, self.spec.experiment, describe)[0].name
+        for table in sorted(self.run_dir.glob("*.csv")):  # metrics, evals, rollouts: all ship
+            write_atomic(model_dir / table.name, lambda p, data=table.read_bytes(): p.write_bytes(data))
+        write_json(model_dir / "meta.json", {
+            **describe, "command": record["commands"][0], **record, "model_files": files, "plot": plot_name,
+            "versions": package_versions(), "cpu": cpu_description(),
+            "finished": datetime.now(timezone.utc).isoformat(timespec="seconds")})
+        return model_dir
 
     def interrupted(self) -> Interrupted:
         self._close()

@@ -37,26 +37,18 @@ def build_q_network(obs_shape: int | tuple, n_actions: int, hidden=(64, 64), due
     return keras.Model(obs, q_values, name=name)
 
 
-def make_optimizer(cfg: DQNConfig) -> keras.optimizers.Optimizer:
-    if cfg.optimizer == "adam":
-        return keras.optimizers.Adam(cfg.lr)
-    if cfg.optimizer == "adamw":  # the PyTorch tutorial's AdamW(amsgrad=True), weight decay 0.01
-        return keras.optimizers.AdamW(cfg.lr, weight_decay=0.01, amsgrad=True)
-    raise ValueError(f"unknown optimizer {cfg.optimizer!r} (adam | adamw)")
-
-
 class DQNAgent:
     """Epsilon-greedy Q-learning agent with a target network that tracks the online one softly."""
 
     def __init__(self, obs_shape: int | tuple, n_actions: int, cfg: DQNConfig):
-        if cfg.loss not in ("mse", "huber"):
-            raise ValueError(f"unknown loss {cfg.loss!r} (mse | huber)")
         self.obs_shape, self.n_actions, self.cfg = as_shape(obs_shape), n_actions, cfg
         self.q_network = build_q_network(self.obs_shape, n_actions, cfg.hidden, cfg.dueling)
         self.target_network = build_q_network(self.obs_shape, n_actions, cfg.hidden, cfg.dueling,
                                               name="target_q_network")
         self.target_network.set_weights(self.q_network.get_weights())
-        self.optimizer = make_optimizer(cfg)
+        # adam, or the PyTorch tutorial's AdamW(amsgrad=True), weight decay 0.01 (the config refuses others)
+        self.optimizer = (keras.optimizers.AdamW(cfg.lr, weight_decay=0.01, amsgrad=True) if cfg.optimizer == "adamw"
+                          else keras.optimizers.Adam(cfg.lr))
         self.optimizer.build(self.q_network.trainable_variables)
         self.policy = acting_forward(self.q_network)  # acting's numpy copy for an MLP, see act()
         self._compiled_updates = {}  # number of stacked minibatches -> tf.function
