@@ -55,5 +55,7 @@ def test_a_card_says_where_the_misses_ended_and_what_ended_them(tmp_path):
     model = _model(tmp_path, "1-2", {"evaluation": {"success_share": 1 / 6, "episodes": 6, "per_episode": episodes}})
     assert docgen.miss_places(model) == ("2,600-2,699: stalled 2; 1,700-1,799: Goomba 1; 2,400-2,499: fell 1; "
                                          "2,400-2,499: no cause recorded 1")
+    assert docgen.miss_causes(model) == "stalled 2, Goomba 1, fell 1, no cause recorded 1"  # stalls counted too
+    assert docgen.miss_causes(_model(tmp_path, "2-2", {"evaluation": {"causes": {"fell": 2}}})) == "fell 2"  # no records
     assert docgen.miss_places(_model(tmp_path, "1-3", {"evaluation": {"success_share": 1.0, "episodes": 1,
                                                                       "per_episode": episodes[:1]}})) == ""

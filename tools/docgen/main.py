@@ -154,16 +154,29 @@ def evaluation_cell(evaluation: dict, m) -> str:
         f" ({share:.0%} full length)" if full else "")
 
 
-def miss_places(m, most: int = 5) -> str:
-    """Where the evaluation's misses ended, most first: ``2,600-2,699: stalled 12; 1,700-1,799: Goomba 3`` (the
-    progress key, Mario's x, in blocks of 100, and what ended each miss: its cause, the stall limit, or neither)."""
-    goal, places = get_experiment(m.experiment).goal, Counter()
+def misses(m) -> list[tuple[float, str]]:
+    """Each miss of the evaluation: (its progress, Mario's x; what ended it: its cause, the stall limit, or
+    neither), from its per-episode records."""
+    goal, found = get_experiment(m.experiment).goal, []
     for r in m.evaluation.get("per_episode") or [] if goal and goal.progress_key else []:
         if not r.get("success") and goal.progress_key in r:
             code = r.get(goal.cause_key) if goal.cause_key else None
-            cause = goal.cause_name(code) if code is not None and code == code else (
-                "stalled" if r.get("stalled") else "no cause recorded")
-            places[(int(r[goal.progress_key]) // 100 * 100, cause)] += 1
+            found.append((r[goal.progress_key], goal.cause_name(code) if code is not None and code == code else
+                          "stalled" if r.get("stalled") else "no cause recorded"))
+    return found
+
+
+def miss_causes(m) -> str:
+    """``stalled 15, fell 1``: what ended the evaluation's misses, most first (the recorded causes where the
+    evaluation kept no per-episode records)."""
+    counts = Counter(cause for _, cause in misses(m)) or Counter(m.evaluation.get("causes") or {})
+    return ", ".join(f"{cause} {n}" for cause, n in counts.most_common())
+
+
+def miss_places(m, most: int = 5) -> str:
+    """Where the evaluation's misses ended, most first: ``2,600-2,699: stalled 12; 1,700-1,799: Goomba 3`` (the
+    progress in blocks of 100, and what ended each miss)."""
+    places = Counter((int(x) // 100 * 100, cause) for x, cause in misses(m))
     return "; ".join(f"{x:,}-{x + 99:,}: {cause} {n}" for (x, cause), n in places.most_common(most))
 
 
@@ -174,7 +187,7 @@ def stop_text(meta: dict, m) -> str:
 
 ENV.filters.update({f.__name__: f for f in (
     link, ret, sweep_score, score_text, bar_text, bar_met, interval, over_seeds, replaced_text,
-    collapses_cell, seeds_bar_text, evaluation_cell, stop_text, miss_places,
+    collapses_cell, seeds_bar_text, evaluation_cell, stop_text, miss_causes, miss_places,
     hours, steps_text, success_word, cpus_text,
     critic_cell, critic_trace, stability_summary)}, json=json.dumps, fmt=format,  # fmt: x|fmt(",.1f"), a format spec
     brief_cpu=lambda text: re.sub(r" \([^)]*\)|\(R\)| Processor", "", text))  # a CPU in a table cell: AMD EPYC
