@@ -116,9 +116,18 @@ def summarize_success(records: list[dict], progress_key: str | None = None) -> d
     return out
 
 
+def miss_cause(record: dict, cause_key: str | None, cause_name) -> str | None:
+    """What ended a failed episode, in words: its cause (``cause_key``, named by ``cause_name``), or ``stalled``
+    where the stall limit ended it (the episode's ``stalled`` mark, as the plots read it); None for neither."""
+    code = record.get(cause_key, np.nan) if cause_key else np.nan
+    if code is not None and not np.isnan(code):
+        return cause_name(code)
+    return "stalled" if record.get("stalled") else None
+
+
 def count_causes(records: list[dict], cause_key: str, cause_name) -> list[tuple[str, int]]:
-    """(cause in words, episodes) over the records that hold ``cause_key``, most first (ties in the
-    order met); numbers that ``cause_name`` puts in the same words (Mario: the five Firebar ids)
-    count together."""
-    names = Counter(cause_name(r[cause_key]) for r in records if not np.isnan(r.get(cause_key, np.nan)))
+    """(what ended the episode in words, episodes) over the records :func:`miss_cause` names, most first (ties
+    in the order met); numbers that ``cause_name`` puts in the same words (Mario: the five Firebar ids) count
+    together, and the stall limit counts as ``stalled``."""
+    names = Counter(name for r in records if (name := miss_cause(r, cause_key, cause_name)) is not None)
     return names.most_common()

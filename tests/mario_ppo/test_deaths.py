@@ -107,3 +107,6 @@ def test_count_causes_counts_by_name_most_first():
     assert count_causes(records, "killed_by", cause_name) == [("Firebar", 3), ("grey Cheep-cheep", 2),
                                                             ("fell", 1)]
     assert count_causes([{"success": True}], "killed_by", cause_name) == []
+    # the stall limit ended it: no enemy's or fall's code, the episode's stalled mark
+    stalls = [{"stalled": 1.0}, {"killed_by": FELL, "stalled": 0.0}, {"stalled": 1.0}]
+    assert count_causes(stalls, "killed_by", cause_name) == [("stalled", 2), ("fell", 1)]

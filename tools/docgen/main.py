@@ -18,6 +18,7 @@ from rlcore.records.commands import cpus_text
 from rlcore.records.critic_trace import WINDOW, critic_cell, critic_trace
 from rlcore.records.eval_history import stability_summary, steps_text
 from rlcore.records.score_words import hours, return_digits, score_words, stop_words, success_word
+from rlcore.training.evaluation import miss_cause
 from tools.docgen import data  # its REPO and shipped_models read at each call (tests point them elsewhere)
 
 ENV = jinja2.Environment(loader=jinja2.PackageLoader("tools.docgen"), undefined=jinja2.StrictUndefined,
@@ -160,9 +161,8 @@ def misses(m) -> list[tuple[float, str]]:
     goal, found = get_experiment(m.experiment).goal, []
     for r in m.evaluation.get("per_episode") or [] if goal and goal.progress_key else []:
         if not r.get("success") and goal.progress_key in r:
-            code = r.get(goal.cause_key) if goal.cause_key else None
-            found.append((r[goal.progress_key], goal.cause_name(code) if code is not None and code == code else
-                          "stalled" if r.get("stalled") else "no cause recorded"))
+            cause = miss_cause(r, goal.cause_key, goal.cause_name) or "no cause recorded"
+            found.append((r[goal.progress_key], cause))
     return found
 
 
