@@ -71,16 +71,18 @@ def users_folder(tmp_path, monkeypatch):
 
     from rlcore.environments import gym_experiment
 
-    (tmp_path / "my_envs.py").write_text("from tests.user_env import ChaseEnv as Chase  # noqa: F401\n")
+    env_class = (Path(__file__).parent / "user_env.py").read_text().split("\ngym.register(")[0]
+    (tmp_path / "my_envs.py").write_text(f"{env_class}\nChase = ChaseEnv\n")  # the class; the README registers it
     monkeypatch.syspath_prepend(str(tmp_path))
     monkeypatch.chdir(tmp_path)
     before, modules, built = dict(gym.registry), set(sys.modules), dict(gym_experiment._BUILT)
+    gym.registry.pop("Chase-v0", None)  # a user's fresh session has not registered it (a test before may have)
     yield tmp_path
     gym.registry.clear()
     gym.registry.update(before)
     gym_experiment._BUILT.clear()  # the experiments built from those registrations, too
     gym_experiment._BUILT.update(built)
-    for name in {"my_envs", "tests.user_env"} - modules:  # imported here: a later import registers again
+    for name in {"my_envs"} - modules:  # imported here: another folder's my_envs is another module
         sys.modules.pop(name, None)
 
 
