@@ -2,7 +2,8 @@
 """Issue 63's trainings, one at a time and in order, each resumed where it stopped: every Mario level
 from 1-1 to 2-4 from one command (the ``flag`` preset, fixed on 2026-12-03 before the first of these
 runs), plus two lever runs that measure a cheaper recipe (``--epochs 4``) on 1-1 and on 2-1 against it, each
-stopped at the flag share 0.9 or at 1.5x the env steps its baseline took to reach it (:func:`lever_limits`).
+stopped at the flag share 0.9 or at 1.5x the env steps its baseline took to reach it (:func:`lever_limits`),
+and trained as soon as that stop is known (:func:`training_order`).
 Each level's run is then evaluated on 30 further unseen seeds.
 
     .venv/bin/python long_runs/queue.py --dry-run     # the next command, from the folders' state
@@ -70,7 +71,7 @@ def train_command(name: str, level: str, extra: list[str]) -> list[str]:
 def next_command(folders: Path = HERE) -> list[str] | None:
     """The next step's ``main.py`` arguments, from the state of the run folders under ``folders``; None
     when the queue has nothing left to run."""
-    for name, level, extra in RUNS:
+    for name, level, extra in training_order(folders):
         run = folders / run_dir(name)
         if shipped(name, folders):
             continue
@@ -88,17 +89,37 @@ def next_command(folders: Path = HERE) -> list[str] | None:
     return None
 
 
+def training_order(folders: Path = HERE) -> list[tuple[str, str, list[str]]]:
+    """RUNS in the order they train now: a lever run moves ahead of its baseline once the baseline, still
+    training, has reached the flag share 0.9, since the lever's stop is fixed from then on (:func:`lever_limits`)
+    and its answer (is the cheaper recipe as good?) is wanted before the later levels start; the baseline then
+    resumes, unchanged. Set 2026-12-07, when 1-1 had reached 0.9 and stayed below its stop share for 1.6M env
+    steps."""
+    order = list(RUNS)
+    for lever in [run for run in RUNS if run[2]]:
+        baseline = folders / run_dir(lever[1])
+        if not (baseline / "model").exists() and not shipped(lever[1], folders) and _reached(baseline):
+            order.remove(lever)
+            order.insert(order.index(next(run for run in order if run[0] == lever[1])), lever)
+    return order
+
+
+def _reached(run: Path) -> int | None:
+    """The env steps at which the run's flag share from the start first reached the lever share, or None."""
+    steps, shares = flag_curve(run / "metrics.csv")
+    return next((step for step, share in zip(steps, shares) if share >= LEVER_SHARE), None)
+
+
 def lever_limits(level: str, folders: Path = HERE) -> list[str]:
     """A lever run's stop, fixed when it starts from its baseline (the level's run of the recipe, which trains
-    before it): the flag share 0.9, or 1.5x the env steps the baseline took to first reach that share (where it
+    before it, to its end or to the share 0.9: :func:`training_order`): the flag share 0.9, or 1.5x the env steps the baseline took to first reach that share (where it
     never did, the baseline's env steps), within the recipe's budget. 4 epochs cost 1/1.23 of 10 per env step
     (benchmarks/mario_recipe.py), so a lever run that needs over 1.23x its baseline's env steps to the same share
     is not cheaper; the margin leaves room for a seed's luck. Set 2026-12-07, before either lever run started."""
     from mario_ppo.experiment import FLAG
 
     baseline = shipped(level, folders) or folders / run_dir(level)
-    steps, shares = flag_curve(baseline / "metrics.csv")
-    reached = next((step for step, share in zip(steps, shares) if share >= LEVER_SHARE), None)
+    reached = _reached(baseline)
     rows = _rows(baseline / "metrics.csv") or []
     budget = round(LEVER_MARGIN * reached) if reached else int(float(rows[-1]["env_steps"])) if rows else None
     return ["--stop-success-share", str(LEVER_SHARE)] + (

@@ -50,6 +50,36 @@ def test_the_queue_trains_each_run_in_order_resumes_it_then_evaluates_it_on_30_f
         _parses(command)
 
 
+def test_a_lever_run_trains_once_its_baselines_stop_is_known_and_the_baseline_then_resumes(tmp_path):
+    """1-1 still training: while its flag share from the start stays below 0.9 it resumes; once it has reached 0.9
+    (here at env step 11,000) the lever run's stop is fixed (1.5x that), so the lever trains, to its end and its
+    evaluations, and then 1-1 resumes with the plain resume command."""
+    baseline = tmp_path / queue.run_dir("1-1")
+    baseline.mkdir(parents=True)
+    (baseline / "checkpoint.npz").write_bytes(b"")
+    rows = [f"{i},{int(i > 20)},{100 * i},0" for i in range(1, 121)]  # the last 100's share: 0.9 first at episode 110
+
+    def episodes(count):
+        (baseline / "metrics.csv").write_text("episode,success,env_steps,restarted\n" + "\n".join(rows[:count]) + "\n")
+        return queue.next_command(tmp_path)
+
+    def resume(name):
+        return ["train", "mario_ppo", "ppo", "--resume", queue.run_dir(name), "--wandb", "offline", "--no-progress"]
+
+    assert episodes(109) == resume("1-1")  # 0.89 at the most
+    lever = queue.train_command("1-1-epochs-4", "1-1", ["--epochs", "4", "--stop-success-share", "0.9", "--steps", "16500"])
+    assert episodes(110) == episodes(120) == lever
+    assert [name for name, _, _ in queue.training_order(tmp_path)][:3] == ["1-1-epochs-4", "1-1", "2-1"]
+    (tmp_path / queue.run_dir("1-1-epochs-4")).mkdir(parents=True)
+    (tmp_path / queue.run_dir("1-1-epochs-4") / "checkpoint.npz").write_bytes(b"")
+    assert queue.next_command(tmp_path) == resume("1-1-epochs-4")
+    _finish(tmp_path / queue.run_dir("1-1-epochs-4"), evaluation={"episodes": 30}, further_evaluations=[{"episodes": 30}])
+    assert queue.next_command(tmp_path) == resume("1-1")
+    _parses(lever)
+    _finish(baseline)  # a finished baseline keeps its place: its evaluation comes before any later run
+    assert [name for name, _, _ in queue.training_order(tmp_path)] == [name for name, _, _ in queue.RUNS]
+
+
 def test_every_level_has_one_run_of_the_recipe_and_only_levers_add_to_it():
     levels = [level for name, level, extra in queue.RUNS if not extra]
     assert sorted(levels) == sorted(queue.LEVELS) == sorted(set(levels))
