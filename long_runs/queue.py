@@ -3,7 +3,8 @@
 from 1-1 to 2-4 from one command (the ``flag`` preset, fixed on 2026-12-03 before the first of these
 runs), plus two lever runs that measure a cheaper recipe (``--epochs 4``) on 1-1 and on 2-1 against it, each
 stopped at the flag share 0.9 or at 1.5x the env steps its baseline took to reach it (:func:`lever_limits`),
-and trained as soon as that stop is known (:func:`training_order`).
+and trained as soon as that stop is known (:func:`training_order`). Where 4 epochs prove cheaper on both,
+the levels not yet started add ``--epochs 4`` (:func:`adopted`).
 Each level's run is then evaluated on 30 further unseen seeds.
 
     .venv/bin/python long_runs/queue.py --dry-run     # the next command, from the folders' state
@@ -46,6 +47,8 @@ RUNS = (("1-1", "1-1", []), ("1-1-epochs-4", "1-1", ["--epochs", "4"]),
 
 
 LEVER_SHARE, LEVER_MARGIN = 0.9, 1.5  # where a lever run stops (lever_limits)
+# how much faster 4 epochs are per env step than 10 (benchmarks/mario_recipe.py, 2026-12-07; docs/notes/speed.md)
+LEVER_SPEEDUP = {"1-1": 1.23, "2-1": 1.30}
 
 
 def run_dir(name: str) -> str:
@@ -85,8 +88,31 @@ def next_command(folders: Path = HERE) -> list[str] | None:
             continue
         if (run / "checkpoint.npz").is_file():
             return ["train", "mario_ppo", "ppo", "--resume", run_dir(name), *QUIET]
-        return train_command(name, level, extra + (lever_limits(level, folders) if extra else []))
+        return train_command(name, level, extra + (lever_limits(level, folders) if extra else adopted(level, folders)))
     return None
+
+
+def adopted(level: str, folders: Path = HERE) -> list[str]:
+    """What a level's run adds to the recipe when it starts: ``--epochs 4`` once both lever runs have
+    finished and on both levels 4 epochs reached the flag share 0.9 for fewer CPU-seconds than the recipe's 10
+    (:func:`levers_cheaper`); nothing for 1-1 and 2-1, whose runs of the recipe are the baselines. Set
+    2026-12-07, before either lever run had an episode."""
+    return ["--epochs", "4"] if level not in LEVER_SPEEDUP and levers_cheaper(folders) else []
+
+
+def levers_cheaper(folders: Path = HERE) -> bool:
+    """Both lever runs have trained, and each reached the flag share 0.9 in fewer env steps than its baseline
+    took times :data:`LEVER_SPEEDUP` (a baseline that never reached 0.9 spent its whole budget, more than its
+    lever's limit)."""
+    for name, level, extra in RUNS:
+        if not extra:
+            continue
+        lever, baseline = folders / run_dir(name), shipped(level, folders) or folders / run_dir(level)
+        if not (lever / "model" / "meta.json").is_file() or (reached := _reached(lever)) is None:
+            return False
+        if (before := _reached(baseline)) is not None and reached >= LEVER_SPEEDUP[level] * before:
+            return False
+    return True
 
 
 def training_order(folders: Path = HERE) -> list[tuple[str, str, list[str]]]:

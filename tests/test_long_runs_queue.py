@@ -80,6 +80,35 @@ def test_a_lever_run_trains_once_its_baselines_stop_is_known_and_the_baseline_th
     assert [name for name, _, _ in queue.training_order(tmp_path)] == [name for name, _, _ in queue.RUNS]
 
 
+def test_the_later_levels_take_4_epochs_only_when_both_lever_runs_reached_0_9_for_fewer_cpu_seconds(tmp_path):
+    """The baselines reached the flag share 0.9 at env step 11,000; 4 epochs are 1.23x (1-1) and 1.30x (2-1) faster
+    per env step, so a lever run that reached it before 13,530 (1-1) or 14,300 (2-1) env steps was cheaper."""
+    def run(name, first_flag_episode, finished=True):
+        folder = tmp_path / queue.run_dir(name)
+        folder.mkdir(parents=True, exist_ok=True)
+        rows = [f"{i},{int(i > first_flag_episode)},{100 * i},0" for i in range(1, 201)]
+        (folder / "metrics.csv").write_text("episode,success,env_steps,restarted\n" + "\n".join(rows) + "\n")
+        (folder / "checkpoint.npz").write_bytes(b"")
+        if finished:
+            _finish(folder, evaluation={"episodes": 30}, further_evaluations=[{"episodes": 30}])
+
+    run("1-1", 20)
+    run("2-1", 20)  # both baselines: 0.9 first at episode 110, env step 11,000
+    run("1-1-epochs-4", 44)  # 0.9 at 13,400: cheaper on 1-1
+    run("2-1-epochs-4", 54, finished=False)  # 14,400, and still training
+    assert queue.adopted("1-2", tmp_path) == [] and queue.next_command(tmp_path)[3] == "--resume"
+    run("2-1-epochs-4", 54)
+    assert not queue.levers_cheaper(tmp_path)  # 14,400 > 1.30 x 11,000 on 2-1
+    assert queue.next_command(tmp_path) == queue.train_command("1-2", "1-2", [])
+    run("2-1-epochs-4", 52)  # 14,200
+    assert queue.levers_cheaper(tmp_path) and queue.adopted("1-2", tmp_path) == ["--epochs", "4"]
+    assert queue.adopted("1-1", tmp_path) == queue.adopted("2-1", tmp_path) == []
+    command = queue.next_command(tmp_path)
+    assert command == queue.train_command("1-2", "1-2", ["--epochs", "4"]) and _parses(command).hp_epochs == 4
+    run("1-1-epochs-4", 200)  # never reached 0.9: not cheaper
+    assert queue.next_command(tmp_path) == queue.train_command("1-2", "1-2", [])
+
+
 def test_every_level_has_one_run_of_the_recipe_and_only_levers_add_to_it():
     levels = [level for name, level, extra in queue.RUNS if not extra]
     assert sorted(levels) == sorted(queue.LEVELS) == sorted(set(levels))
