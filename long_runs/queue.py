@@ -65,6 +65,11 @@ def shipped(name: str, folders: Path = HERE) -> Path | None:
     return target if json.loads((target / "meta.json").read_text()).get("preset") == PRESET else None
 
 
+def home(name: str, folders: Path = HERE) -> Path:
+    """Where a run's files are: its model folder in saved_networks/ once published, else its long_runs folder."""
+    return shipped(name, folders) or folders / run_dir(name)
+
+
 def train_command(name: str, level: str, extra: list[str]) -> list[str]:
     world, stage = level.split("-")
     return ["train", "mario_ppo", "ppo", *RECIPE, "--world", world, "--stage", stage, *extra,
@@ -88,7 +93,8 @@ def next_command(folders: Path = HERE) -> list[str] | None:
             continue
         if (run / "checkpoint.npz").is_file():
             return ["train", "mario_ppo", "ppo", "--resume", run_dir(name), *QUIET]
-        return train_command(name, level, extra + (lever_limits(level, folders) if extra else adopted(level, folders)))
+        added = lever_limits(level, folders) if extra else adopted(level, folders)
+        return train_command(name, level, extra + added)
     return None
 
 
@@ -97,20 +103,21 @@ def adopted(level: str, folders: Path = HERE) -> list[str]:
     finished and on both levels 4 epochs reached the flag share 0.9 for fewer CPU-seconds than the recipe's 10
     (:func:`levers_cheaper`); nothing for 1-1 and 2-1, whose runs of the recipe are the baselines. Set
     2026-12-07, before either lever run had an episode."""
-    return ["--epochs", "4"] if level not in LEVER_SPEEDUP and levers_cheaper(folders) else []
+    has_lever = any(extra and lever_level == level for _, lever_level, extra in RUNS)
+    return ["--epochs", "4"] if not has_lever and levers_cheaper(folders) else []
 
 
 def levers_cheaper(folders: Path = HERE) -> bool:
     """Both lever runs have trained, and each reached the flag share 0.9 in fewer env steps than its baseline
-    took times :data:`LEVER_SPEEDUP` (a baseline that never reached 0.9 spent its whole budget, more than its
-    lever's limit)."""
+    took times :data:`LEVER_SPEEDUP` (a baseline that never reached 0.9 spent its whole budget without it, so a
+    lever that reached it within that budget, its limit, was cheaper)."""
     for name, level, extra in RUNS:
         if not extra:
             continue
-        lever, baseline = folders / run_dir(name), shipped(level, folders) or folders / run_dir(level)
+        lever = folders / run_dir(name)
         if not (lever / "model" / "meta.json").is_file() or (reached := _reached(lever)) is None:
             return False
-        if (before := _reached(baseline)) is not None and reached >= LEVER_SPEEDUP[level] * before:
+        if (before := _reached(home(level, folders))) is not None and reached >= LEVER_SPEEDUP[level] * before:
             return False
     return True
 
@@ -138,13 +145,14 @@ def _reached(run: Path) -> int | None:
 
 def lever_limits(level: str, folders: Path = HERE) -> list[str]:
     """A lever run's stop, fixed when it starts from its baseline (the level's run of the recipe, which trains
-    before it, to its end or to the share 0.9: :func:`training_order`): the flag share 0.9, or 1.5x the env steps the baseline took to first reach that share (where it
-    never did, the baseline's env steps), within the recipe's budget. 4 epochs cost 1/1.23 of 10 per env step
+    before it, to its end or to the share 0.9: :func:`training_order`): the flag share 0.9, or 1.5x the env steps
+    the baseline took to first reach that share (where it never did, the baseline's env steps), within the
+    recipe's budget. 4 epochs cost 1/1.23 of 10 per env step
     (benchmarks/mario_recipe.py), so a lever run that needs over 1.23x its baseline's env steps to the same share
     is not cheaper; the margin leaves room for a seed's luck. Set 2026-12-07, before either lever run started."""
     from mario_ppo.experiment import FLAG
 
-    baseline = shipped(level, folders) or folders / run_dir(level)
+    baseline = home(level, folders)
     reached = _reached(baseline)
     rows = _rows(baseline / "metrics.csv") or []
     budget = round(LEVER_MARGIN * reached) if reached else int(float(rows[-1]["env_steps"])) if rows else None
@@ -238,7 +246,7 @@ def plot(path: Path, folders: Path = HERE) -> None:
         ax.plot([s / 1e6 for s in steps], shares, color="silver", linewidth=0.8,
                 label="1-1, default preset (3 seeds)" if i == 0 else None)
     for name, _, extra in RUNS:
-        steps, shares = flag_curve((shipped(name, folders) or folders / run_dir(name)) / "metrics.csv")
+        steps, shares = flag_curve(home(name, folders) / "metrics.csv")
         if steps:
             ax.plot([s / 1e6 for s in steps], shares, label=name, linestyle="--" if extra else "-", linewidth=1.2)
     ax.axhline(0.9, color="gray", linewidth=0.8, linestyle=":", label="bar: 27 of 30")
